@@ -1,0 +1,3 @@
+//! The atom firmware.
+#![cfg_attr(not(test), no_std)]
+#![forbid(unsafe_code)]

@@ -1,0 +1,3 @@
+//! The basic firmware.
+#![cfg_attr(not(test), no_std)]
+#![forbid(unsafe_code)]

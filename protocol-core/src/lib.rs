@@ -1,0 +1,20 @@
+//! The two protocols that travel on a myCobot 280 M5's wires, typed and zero-allocation.
+//!
+//! * [`frame`]: host frames `FE FE LEN CMD DATA FA` and a streaming decoder that finds them in
+//!   any byte stream (any chunking, garbage, servo packets on the same wire).
+//! * [`servo`]: Feetech STS servo packets `FF FF ID LEN ...`, their checksum, register values
+//!   and a streaming packet decoder.
+//! * [`units`]: the protocol's units as distinct types.
+//! * [`port`]: the byte-link trait both firmwares and the virtual robot are written against.
+//!
+//! Nothing in this crate panics on any input.
+#![cfg_attr(not(test), no_std)]
+#![forbid(unsafe_code)]
+
+pub mod frame;
+pub mod port;
+pub mod servo;
+pub mod units;
+
+pub use frame::{Frame, FrameDecoder};
+pub use port::BytePort;

@@ -1,0 +1,2 @@
+//! `cargo run --release`: starts the virtual robot.
+fn main() {}
