@@ -6,6 +6,7 @@
 //!   and a streaming packet decoder.
 //! * [`units`]: the protocol's units as distinct types.
 //! * [`port`]: the byte-link trait both firmwares and the virtual robot are written against.
+//! * [`timing`]: baud rates and the bus-sharing rules every station follows.
 //!
 //! Nothing in this crate panics on any input.
 #![cfg_attr(not(test), no_std)]
@@ -14,7 +15,8 @@
 pub mod frame;
 pub mod port;
 pub mod servo;
+pub mod timing;
 pub mod units;
 
 pub use frame::{Frame, FrameDecoder};
-pub use port::BytePort;
+pub use port::{BytePort, NullPort};

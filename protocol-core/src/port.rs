@@ -15,3 +15,20 @@ pub trait BytePort {
     /// True once every byte passed to [`BytePort::write`] has left the transmitter.
     fn tx_idle(&self) -> bool;
 }
+
+/// A port with nothing attached: never receives, discards what is written. For a board
+/// without a direct host link, or a test that does not care about one side.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NullPort;
+
+impl BytePort for NullPort {
+    fn read_byte(&mut self) -> Option<u8> {
+        None
+    }
+
+    fn write(&mut self, _bytes: &[u8]) {}
+
+    fn tx_idle(&self) -> bool {
+        true
+    }
+}
