@@ -1,0 +1,56 @@
+//! Settings of the transponder. [`BasicConfig::default`] is the real board.
+
+use protocol_core::timing;
+
+/// Whether the Basic hears its own transmissions on the bus (TX and RX tied on the wire).
+/// The wiring is not documented, so the default finds out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EchoMode {
+    /// Decide from what comes back: an echo is checked once it has been heard; a frame that
+    /// comes back silent counts as sent until then.
+    #[default]
+    Auto,
+    /// Every transmitted byte comes back; a missing or different echo is a collision.
+    Present,
+    /// Nothing transmitted comes back; any byte heard while transmitting is a collision.
+    Absent,
+}
+
+/// Settings of the transponder.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BasicConfig {
+    /// How the bus echo is handled.
+    pub echo: EchoMode,
+    /// How long a forwarded host request waits for the Atom's reply before the next request
+    /// may go, in microseconds. Below pymycobot's 0.5 s resend so its resend is forwarded.
+    pub reply_timeout_us: u64,
+    /// How long an internal request (power-on, probe) waits for its reply, in microseconds.
+    pub probe_timeout_us: u64,
+    /// Transmissions of one frame before it is given up after collisions (at least 1).
+    pub max_send_attempts: u8,
+    /// Time after power-up before the Basic powers the Atom on (0x10), in microseconds; the
+    /// Atom boots in parallel and must be listening.
+    pub boot_power_on_delay_us: u64,
+    /// With no answer from the Atom for this long while idle, the Basic probes it (0x12), in
+    /// microseconds; 0 disables probing (and the boot power-on retries).
+    pub probe_interval_us: u64,
+    /// Whether to send 0x10 (power on) to the Atom at boot, like the vendor transponder.
+    pub power_on_at_boot: bool,
+    /// The version the Basic reports for 0xC1, times ten (10 = "1.0").
+    pub version_x10: u8,
+}
+
+impl Default for BasicConfig {
+    fn default() -> Self {
+        Self {
+            echo: EchoMode::Auto,
+            reply_timeout_us: timing::HOST_REPLY_DEADLINE_US * 4 / 5,
+            probe_timeout_us: 50_000,
+            max_send_attempts: 8,
+            boot_power_on_delay_us: 1_000_000,
+            probe_interval_us: 1_000_000,
+            power_on_at_boot: true,
+            version_x10: 10,
+        }
+    }
+}
