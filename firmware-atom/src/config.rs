@@ -1,0 +1,290 @@
+//! Everything about the arm the Atom must know, with the real arm's values as the default and
+//! one validation point ([`AtomConfig::validate`]).
+
+use protocol_core::units::{Centideg, Steps};
+
+/// Number of arm joints (servos 1..6).
+pub const JOINTS: usize = 6;
+/// Number of servos on the bus: the six joints and the gripper.
+pub const SERVOS: usize = 7;
+/// Index of the gripper in per-servo arrays (servo id 7 on the real arm).
+pub const GRIPPER: usize = 6;
+
+/// Encoder steps per full turn (`servo-bus.md`).
+pub const STEPS_PER_TURN: i32 = 4096;
+/// Encoder reading at 0 degrees.
+pub const STEPS_ZERO: i32 = 2048;
+
+/// Direction of a joint: whether more encoder steps mean more degrees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JointSign {
+    /// +steps = +degrees.
+    Positive,
+    /// +steps = -degrees.
+    Negative,
+}
+
+/// Lower and upper limit of one joint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct JointLimit {
+    /// Smallest angle a goal may have.
+    pub min: Centideg,
+    /// Largest angle a goal may have.
+    pub max: Centideg,
+}
+
+impl JointLimit {
+    /// A limit from degrees.
+    pub const fn degrees(min: i16, max: i16) -> Self {
+        Self {
+            min: Centideg(min * 100),
+            max: Centideg(max * 100),
+        }
+    }
+
+    /// True if `angle` lies within the limit (ends included).
+    pub fn contains(&self, angle: Centideg) -> bool {
+        self.min <= angle && angle <= self.max
+    }
+}
+
+/// Joint limits of the current vendor firmware (`kinematics.md`): J1 +-168, J2 +-140,
+/// J3 +-150, J4 +-150, J5 -155..+160, J6 +-180 degrees.
+pub const DEFAULT_LIMITS: [JointLimit; JOINTS] = [
+    JointLimit::degrees(-168, 168),
+    JointLimit::degrees(-140, 140),
+    JointLimit::degrees(-150, 150),
+    JointLimit::degrees(-150, 150),
+    JointLimit::degrees(-155, 160),
+    JointLimit::degrees(-180, 180),
+];
+
+/// Speeds and accelerations at 100 % (`kinematics.md`: joints up to 150 deg/s and 200 deg/s^2,
+/// Cartesian up to 100 mm/s).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MotionLimits {
+    /// Fastest joint speed, centidegrees per second.
+    pub joint_speed_centideg_per_s: u32,
+    /// Fastest joint acceleration, centidegrees per second squared.
+    pub joint_accel_centideg_per_s2: u32,
+    /// Fastest Cartesian speed, tenth-millimetres per second.
+    pub linear_speed_decimm_per_s: u32,
+    /// Fastest rotation speed of jog rpy and linear moves, centidegrees per second.
+    pub rotation_speed_centideg_per_s: u32,
+}
+
+impl Default for MotionLimits {
+    fn default() -> Self {
+        Self {
+            joint_speed_centideg_per_s: 15_000,
+            joint_accel_centideg_per_s2: 20_000,
+            linear_speed_decimm_per_s: 1_000,
+            rotation_speed_centideg_per_s: 9_000,
+        }
+    }
+}
+
+/// The gripper servo's encoder range: value 0 (closed) .. 100 (open) maps linearly onto
+/// `closed ..= open`. Calibration (0x68) makes the present position the new `closed` (the servo
+/// is told "current position = 2048") and keeps the span.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GripperRange {
+    /// Encoder position of gripper value 0 (closed).
+    pub closed: Steps,
+    /// Encoder position of gripper value 100 (open).
+    pub open: Steps,
+}
+
+impl Default for GripperRange {
+    /// Closed at the calibrated zero 2048, open a quarter turn (1024 steps, 90 deg) away: the
+    /// travel of the myCobot parallel gripper's crank.
+    fn default() -> Self {
+        Self {
+            closed: Steps(2048),
+            open: Steps(2048 + 1024),
+        }
+    }
+}
+
+/// Time budgets of the servo bus and the host link, in microseconds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TimingBudget {
+    /// Extra time allowed for a servo reply beyond instruction wire time + the worst
+    /// turnaround + reply wire time. 150 us covers the servo's return delay register (default
+    /// 0 on the arm) plus scheduling jitter of the board loop.
+    pub reply_margin_us: u64,
+    /// How often a servo transaction that expects a reply is retried after a timeout or a bad
+    /// checksum before the command fails (`servo-bus.md`: corrupted replies are retried).
+    pub retries: u8,
+    /// Consecutive missed state reads after which a servo is reported as not answering. Three
+    /// misses = about 1.5 ms of lost data: one collision never marks a servo dead.
+    pub misses_before_lost: u8,
+    /// Period of the straight-line and jog interpolators: a new set of goals every 20 ms, short
+    /// enough that the servos' own ramp keeps the path within a fraction of a millimetre.
+    pub interpolation_period_us: u64,
+    /// A continuous jog (0x30..0x32) stops if no host command arrives for this long. 2 s: long
+    /// enough for a script that jogs, sleeps a second and stops (pymycobot has no keep-alive),
+    /// short enough that a lost link cannot drive a joint far (at most 2 s of motion).
+    pub jog_watchdog_us: u64,
+    /// How long a bus reply may wait for a quiet wire before it is dropped (the host resends).
+    pub reply_hold_max_us: u64,
+}
+
+impl Default for TimingBudget {
+    fn default() -> Self {
+        Self {
+            reply_margin_us: 150,
+            retries: 2,
+            misses_before_lost: 3,
+            interpolation_period_us: 20_000,
+            jog_watchdog_us: 2_000_000,
+            reply_hold_max_us: 100_000,
+        }
+    }
+}
+
+/// Why an [`AtomConfig`] cannot be used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ConfigError {
+    /// A servo id is outside 0..=0xFC or used twice.
+    BadServoId,
+    /// A joint limit has min > max or exceeds +-180 degrees.
+    BadJointLimit,
+    /// The gripper range is empty or outside 0..4095.
+    BadGripperRange,
+    /// A speed, acceleration or period is zero.
+    BadTiming,
+}
+
+/// The Atom's configuration. `Default` is the real arm.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AtomConfig {
+    /// Bus ids of joints 1..6 and the gripper (real arm: 1..=7).
+    pub servo_ids: [u8; SERVOS],
+    /// Direction of each joint: the one place that says whether +steps is +degrees.
+    pub joint_signs: [JointSign; JOINTS],
+    /// Joint limits at boot (settable at run time with 0x4C/0x4D).
+    pub joint_limits: [JointLimit; JOINTS],
+    /// Speeds at 100 %.
+    pub motion: MotionLimits,
+    /// Gripper encoder range.
+    pub gripper: GripperRange,
+    /// Bus and host-link time budgets.
+    pub timing: TimingBudget,
+    /// Whether the Atom starts with torque on (the virtual robot); on the real arm the Basic
+    /// sends power on (0x10) at boot.
+    pub powered_at_boot: bool,
+}
+
+impl Default for AtomConfig {
+    fn default() -> Self {
+        Self {
+            servo_ids: [1, 2, 3, 4, 5, 6, 7],
+            joint_signs: [JointSign::Positive; JOINTS],
+            joint_limits: DEFAULT_LIMITS,
+            motion: MotionLimits::default(),
+            gripper: GripperRange::default(),
+            timing: TimingBudget::default(),
+            powered_at_boot: false,
+        }
+    }
+}
+
+impl AtomConfig {
+    /// Checks every field; the one place a bad configuration is caught.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        for (i, &id) in self.servo_ids.iter().enumerate() {
+            let dup = self.servo_ids.iter().skip(i + 1).any(|&other| other == id);
+            if id > protocol_core::servo::MAX_ID || dup {
+                return Err(ConfigError::BadServoId);
+            }
+        }
+        if self
+            .joint_limits
+            .iter()
+            .any(|l| l.min > l.max || l.min.0 < -18_000 || l.max.0 > 18_000)
+        {
+            return Err(ConfigError::BadJointLimit);
+        }
+        let (closed, open) = (self.gripper.closed.0, self.gripper.open.0);
+        if closed == open || !(0..4096).contains(&closed) || !(0..4096).contains(&open) {
+            return Err(ConfigError::BadGripperRange);
+        }
+        let m = &self.motion;
+        let t = &self.timing;
+        if m.joint_speed_centideg_per_s == 0
+            || m.joint_accel_centideg_per_s2 == 0
+            || m.linear_speed_decimm_per_s == 0
+            || m.rotation_speed_centideg_per_s == 0
+            || t.interpolation_period_us == 0
+            || t.misses_before_lost == 0
+        {
+            return Err(ConfigError::BadTiming);
+        }
+        Ok(())
+    }
+
+    /// Joint angle of encoder position `steps` of joint `joint` (0-based).
+    pub fn steps_to_angle(&self, joint: usize, steps: Steps) -> Centideg {
+        let delta = i32::from(steps.0) - STEPS_ZERO;
+        let centideg = (delta * 36_000 + delta.signum() * STEPS_PER_TURN / 2) / STEPS_PER_TURN;
+        let signed = match self.joint_signs.get(joint) {
+            Some(JointSign::Negative) => -centideg,
+            _ => centideg,
+        };
+        Centideg(signed.clamp(-18_000, 18_000) as i16)
+    }
+
+    /// Encoder position of joint `joint` (0-based) at `angle`.
+    pub fn angle_to_steps(&self, joint: usize, angle: Centideg) -> Steps {
+        let a = i32::from(angle.0);
+        let a = match self.joint_signs.get(joint) {
+            Some(JointSign::Negative) => -a,
+            _ => a,
+        };
+        let delta = (a * STEPS_PER_TURN + a.signum() * 18_000) / 36_000;
+        Steps((STEPS_ZERO + delta).clamp(0, STEPS_PER_TURN - 1) as i16)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_is_valid() {
+        assert_eq!(AtomConfig::default().validate(), Ok(()));
+    }
+
+    #[test]
+    fn validation_catches_each_mistake() {
+        let mut c = AtomConfig::default();
+        c.servo_ids[3] = 2;
+        assert_eq!(c.validate(), Err(ConfigError::BadServoId));
+        let mut c = AtomConfig::default();
+        c.joint_limits[0] = JointLimit::degrees(10, -10);
+        assert_eq!(c.validate(), Err(ConfigError::BadJointLimit));
+        let mut c = AtomConfig::default();
+        c.gripper.open = c.gripper.closed;
+        assert_eq!(c.validate(), Err(ConfigError::BadGripperRange));
+        let mut c = AtomConfig::default();
+        c.timing.interpolation_period_us = 0;
+        assert_eq!(c.validate(), Err(ConfigError::BadTiming));
+    }
+
+    #[test]
+    fn angle_and_steps_round_trip_within_one_step() {
+        let mut c = AtomConfig::default();
+        c.joint_signs[1] = JointSign::Negative;
+        assert_eq!(c.angle_to_steps(0, Centideg(0)), Steps(2048));
+        assert_eq!(c.angle_to_steps(0, Centideg(9000)), Steps(3072));
+        assert_eq!(c.angle_to_steps(1, Centideg(9000)), Steps(1024));
+        for a in (-18_000i16..=18_000).step_by(7) {
+            for j in 0..2 {
+                let back = c.steps_to_angle(j, c.angle_to_steps(j, Centideg(a)));
+                // One step is 8.8 centidegrees.
+                assert!((i32::from(back.0) - i32::from(a)).abs() <= 5, "{a} -> {back:?}");
+            }
+        }
+    }
+}

@@ -1,0 +1,35 @@
+//! What the Atom knows about each servo, refreshed from the bus.
+
+use protocol_core::units::Steps;
+
+/// The latest state read from one servo (present-state block, `servo-bus.md`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ServoHealth {
+    /// True while the servo answers; false after
+    /// [`TimingBudget::misses_before_lost`](crate::TimingBudget) consecutive missed reads.
+    pub answering: bool,
+    /// True once at least one state read succeeded since boot.
+    pub ever_answered: bool,
+    /// Fault bits of the last status packet and register 65 (`protocol_core::servo::fault`).
+    pub fault_bits: u8,
+    /// Present position.
+    pub position: Steps,
+    /// Present speed, steps per second (signed).
+    pub speed_steps_per_s: i16,
+    /// Present load, signed, 0.1 % of the maximum torque.
+    pub load_permille: i16,
+    /// Present current, signed, in the servo's 6.5 mA units.
+    pub current_raw: i16,
+    /// Supply voltage, tenths of a volt.
+    pub voltage_decivolt: u8,
+    /// Temperature, degrees Celsius.
+    pub temperature_c: u8,
+    /// The servo's moving flag.
+    pub moving: bool,
+    /// Whether the Atom last switched this servo's torque on.
+    pub torque_on: bool,
+    /// Failed transactions (timeouts and bad checksums) since boot. Wraps.
+    pub comm_errors: u32,
+    /// Consecutive missed state reads.
+    pub(crate) misses: u8,
+}
