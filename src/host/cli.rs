@@ -1,0 +1,53 @@
+//! The command line of the virtual robot.
+
+use std::net::SocketAddr;
+use std::path::PathBuf;
+
+use clap::Parser;
+
+/// Virtual myCobot 280 M5: the real Basic and Atom firmware logic, simulated servos, served in
+/// real time on a pseudo-terminal (and optionally TCP) to pymycobot or any serial client.
+#[derive(Debug, Parser)]
+#[command(version, about)]
+pub struct Cli {
+    /// Also create a symlink at PATH to the pseudo-terminal (a stale one is replaced; removed
+    /// on exit), e.g. `--pty-link /tmp/mycobot` then `MyCobot280("/tmp/mycobot")`.
+    #[arg(long, value_name = "PATH")]
+    pub pty_link: Option<PathBuf>,
+
+    /// Also serve the host protocol over TCP on ADDR:PORT (raw frames, like the Basic's Wi-Fi
+    /// server), e.g. `--tcp 127.0.0.1:9000` then `MyCobot280Socket("127.0.0.1", 9000)`.
+    /// Port 0 picks a free port; the address used is printed.
+    #[arg(long, value_name = "ADDR:PORT")]
+    pub tcp: Option<SocketAddr>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn options_parse_and_bad_addresses_are_refused() {
+        let cli = Cli::try_parse_from([
+            "open-mycobot",
+            "--pty-link",
+            "/tmp/mycobot",
+            "--tcp",
+            "127.0.0.1:9000",
+        ])
+        .unwrap();
+        assert_eq!(cli.pty_link, Some(PathBuf::from("/tmp/mycobot")));
+        assert_eq!(cli.tcp, Some("127.0.0.1:9000".parse().unwrap()));
+
+        let bare = Cli::try_parse_from(["open-mycobot"]).unwrap();
+        assert!(bare.pty_link.is_none() && bare.tcp.is_none());
+
+        assert!(Cli::try_parse_from(["open-mycobot", "--tcp", "9000"]).is_err());
+    }
+
+    #[test]
+    fn clap_configuration_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
+    }
+}

@@ -1,0 +1,14 @@
+//! The front end of the virtual robot: what `cargo run --release` puts in front of the
+//! simulated arm so that unmodified clients can drive it.
+//!
+//! * [`pty`]: a raw pseudo-terminal standing in for the Basic's USB serial port;
+//! * [`pty_link`]: a stable symlink to it (`--pty-link`);
+//! * [`tcp`]: the host protocol over TCP, like the Basic's Wi-Fi server (`--tcp`);
+//! * [`realtime`]: the loop that runs the robot at wall-clock speed and moves the bytes;
+//! * [`cli`]: the command line.
+
+pub mod cli;
+pub mod pty;
+pub mod pty_link;
+pub mod realtime;
+pub mod tcp;

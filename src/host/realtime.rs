@@ -1,0 +1,243 @@
+//! Runs the virtual robot in real time and connects it to the host's clients.
+//!
+//! One loop, no threads: wait up to [`TICK`] for a client's bytes (`ppoll`, so input wakes it
+//! at once), advance the robot's virtual time to the wall clock, hand it the input, and pass
+//! what the Basic sent back to the client that spoke last. With a 200 us tick, a reply leaves
+//! at most ~200 us after the simulated wire finished sending it, well under the 87 us x 17
+//! bytes a `get_angles` reply spends on the 115200 baud wire itself.
+
+use std::io;
+use std::os::fd::BorrowedFd;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use nix::poll::{PollFd, PollFlags, ppoll};
+use nix::sys::time::TimeSpec;
+
+use super::pty::PseudoTerminal;
+use super::tcp::{ClientId, TcpServer};
+
+/// The longest the loop sleeps between two advances of virtual time.
+pub const TICK: Duration = Duration::from_micros(200);
+
+/// If the simulation falls this far behind the wall clock (a slow or overloaded machine, a
+/// stopped process), the debt is forgiven instead of fast-forwarding the arm in one jump.
+pub const MAX_CATCH_UP: Duration = Duration::from_millis(50);
+
+/// The robot as the front end sees it: the host side of the Basic's serial line, and time.
+pub trait HostLink {
+    /// Virtual time, microseconds since the robot started.
+    fn now_us(&self) -> u64;
+    /// Bytes from the host towards the Basic (they go out on the simulated 115200 line).
+    fn host_write(&mut self, bytes: &[u8]);
+    /// Appends what the Basic sent to the host so far.
+    fn host_read(&mut self, out: &mut Vec<u8>);
+    /// Advances virtual time to `t_us`.
+    fn run_until(&mut self, t_us: u64);
+}
+
+/// Where the robot's replies go: to whoever sent the last request.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Talker {
+    Pty,
+    Tcp(ClientId),
+}
+
+/// The real-time loop: a robot, its pseudo-terminal and optionally a TCP server.
+pub struct RealtimeDriver<R> {
+    robot: R,
+    pty: PseudoTerminal,
+    tcp: Option<TcpServer>,
+    talker: Talker,
+}
+
+impl<R: HostLink> RealtimeDriver<R> {
+    /// Connects `robot` to `pty` and, if given, `tcp`.
+    pub fn new(robot: R, pty: PseudoTerminal, tcp: Option<TcpServer>) -> Self {
+        Self {
+            robot,
+            pty,
+            tcp,
+            talker: Talker::Pty,
+        }
+    }
+
+    /// The pseudo-terminal clients open.
+    pub fn pty(&self) -> &PseudoTerminal {
+        &self.pty
+    }
+
+    /// The TCP server, if one was asked for.
+    pub fn tcp(&self) -> Option<&TcpServer> {
+        self.tcp.as_ref()
+    }
+
+    /// Runs until `stop` is set (by a signal handler), then returns the robot.
+    pub fn run(mut self, stop: &AtomicBool) -> io::Result<R> {
+        let wall_start = Instant::now();
+        let mut virtual_at_start = self.robot.now_us();
+        let mut input = [0u8; 4096];
+        let mut output = Vec::with_capacity(256);
+        while !stop.load(Ordering::Relaxed) {
+            self.wait_for_input()?;
+
+            let mut target_us = virtual_at_start + micros(wall_start.elapsed());
+            let behind_us = target_us.saturating_sub(self.robot.now_us());
+            if behind_us > micros(MAX_CATCH_UP) {
+                virtual_at_start -= behind_us - micros(MAX_CATCH_UP);
+                target_us = virtual_at_start + micros(wall_start.elapsed());
+            }
+            self.robot.run_until(target_us);
+
+            self.forward_client_input(&mut input)?;
+
+            output.clear();
+            self.robot.host_read(&mut output);
+            if !output.is_empty() {
+                self.deliver(&output)?;
+            }
+        }
+        Ok(self.robot)
+    }
+
+    /// Sleeps until a client sends something or [`TICK`] passes.
+    fn wait_for_input(&self) -> io::Result<()> {
+        let pty_fd: BorrowedFd<'_> = std::os::fd::AsFd::as_fd(&self.pty);
+        let mut fds: Vec<PollFd<'_>> = std::iter::once(pty_fd)
+            .chain(self.tcp.iter().flat_map(TcpServer::poll_fds))
+            .map(|fd| PollFd::new(fd, PollFlags::POLLIN))
+            .collect();
+        match ppoll(&mut fds, Some(TimeSpec::from_duration(TICK)), None) {
+            Ok(_) | Err(nix::errno::Errno::EINTR) => Ok(()),
+            Err(e) => Err(e.into()),
+        }
+    }
+
+    fn forward_client_input(&mut self, buf: &mut [u8]) -> io::Result<()> {
+        loop {
+            let n = self.pty.read_available(buf)?;
+            let Some(bytes) = buf.get(..n).filter(|b| !b.is_empty()) else {
+                break;
+            };
+            self.robot.host_write(bytes);
+            self.talker = Talker::Pty;
+        }
+        if let Some(tcp) = self.tcp.as_mut() {
+            tcp.accept_pending();
+            let robot = &mut self.robot;
+            let talker = &mut self.talker;
+            tcp.receive(|id, bytes| {
+                robot.host_write(bytes);
+                *talker = Talker::Tcp(id);
+            });
+        }
+        Ok(())
+    }
+
+    fn deliver(&mut self, bytes: &[u8]) -> io::Result<()> {
+        match self.talker {
+            Talker::Pty => {
+                self.pty.write_or_drop(bytes)?;
+            }
+            Talker::Tcp(id) => {
+                if let Some(tcp) = self.tcp.as_mut() {
+                    tcp.send_reply_bytes(id, bytes);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+fn micros(d: Duration) -> u64 {
+    u64::try_from(d.as_micros()).unwrap_or(u64::MAX)
+}
+
+/// A flag set by SIGINT, SIGTERM or SIGHUP, for [`RealtimeDriver::run`].
+pub fn stop_on_signals() -> io::Result<Arc<AtomicBool>> {
+    let stop = Arc::new(AtomicBool::new(false));
+    for signal in [
+        signal_hook::consts::SIGINT,
+        signal_hook::consts::SIGTERM,
+        signal_hook::consts::SIGHUP,
+    ] {
+        signal_hook::flag::register(signal, Arc::clone(&stop))?;
+    }
+    Ok(stop)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::fs::OpenOptions;
+    use std::io::{Read, Write};
+
+    /// Answers each request byte-timed like the real Basic: 87 us per byte after a 1 ms think.
+    struct AckingRobot {
+        now_us: u64,
+        inbox: Vec<u8>,
+        outbox: Vec<(u64, u8)>,
+    }
+
+    impl HostLink for AckingRobot {
+        fn now_us(&self) -> u64 {
+            self.now_us
+        }
+        fn host_write(&mut self, bytes: &[u8]) {
+            self.inbox.extend_from_slice(bytes);
+            if let [0xFE, 0xFE, _, cmd, .., 0xFA] = self.inbox[..] {
+                for (i, byte) in [0xFE, 0xFE, 0x03, cmd, 0x01, 0xFA].into_iter().enumerate() {
+                    self.outbox
+                        .push((self.now_us + 1_000 + 87 * i as u64, byte));
+                }
+                self.inbox.clear();
+            }
+        }
+        fn host_read(&mut self, out: &mut Vec<u8>) {
+            let now = self.now_us;
+            out.extend(
+                self.outbox
+                    .iter()
+                    .filter(|(t, _)| *t <= now)
+                    .map(|(_, b)| b),
+            );
+            self.outbox.retain(|(t, _)| *t > now);
+        }
+        fn run_until(&mut self, t_us: u64) {
+            assert!(t_us >= self.now_us, "time went backwards");
+            self.now_us = t_us;
+        }
+    }
+
+    #[test]
+    fn a_client_on_the_pty_gets_its_reply_and_the_loop_stops_on_request() {
+        let robot = AckingRobot {
+            now_us: 5,
+            inbox: Vec::new(),
+            outbox: Vec::new(),
+        };
+        let driver = RealtimeDriver::new(robot, PseudoTerminal::open().unwrap(), None);
+        let path = driver.pty().slave_path().to_path_buf();
+        let stop = Arc::new(AtomicBool::new(false));
+        let loop_stop = Arc::clone(&stop);
+        let handle = std::thread::spawn(move || driver.run(&loop_stop).map(|r| r.now_us));
+
+        let mut client = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(&path)
+            .unwrap();
+        client.write_all(&[0xFE, 0xFE, 0x02, 0x12, 0xFA]).unwrap();
+        let mut reply = [0u8; 6];
+        client.read_exact(&mut reply).unwrap();
+        assert_eq!(reply, [0xFE, 0xFE, 0x03, 0x12, 0x01, 0xFA]);
+
+        stop.store(true, Ordering::Relaxed);
+        let virtual_end_us = handle.join().unwrap().unwrap();
+        assert!(
+            virtual_end_us > 1_000,
+            "virtual time followed the wall clock"
+        );
+    }
+}
