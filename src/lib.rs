@@ -2,3 +2,4 @@
 //! a simulated shared bus to simulated Feetech STS servos.
 #![forbid(unsafe_code)]
 pub mod host;
+pub mod sim;

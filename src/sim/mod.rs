@@ -1,0 +1,25 @@
+//! The simulation core of the virtual robot: wires with byte timing, Feetech STS servos, and
+//! the whole arm under virtual time.
+//!
+//! * [`wire`]: the shared 1 Mbaud half-duplex bus (every station hears every byte, overlapping
+//!   transmissions garble each other, echo per station) and 115200 serial lines.
+//! * [`servo`]: a simulated STS servo: control table, instructions, trapezoidal motion, faults.
+//! * [`VirtualRobot`]: the real `firmware_basic::Basic` and `firmware_atom::Atom` wired to seven
+//!   servos; time advances only in [`VirtualRobot::run_until`], as fast as the host can.
+//!
+//! ```
+//! use open_mycobot::sim::{RobotConfig, VirtualRobot};
+//!
+//! let mut robot = VirtualRobot::new(RobotConfig::default());
+//! robot.run_for(1_000);
+//! assert_eq!(robot.now_us(), 1_000);
+//! assert_eq!(robot.servo(1).map(|s| s.present_position()), Some(2048));
+//! ```
+
+mod robot;
+pub mod servo;
+pub mod wire;
+
+pub use robot::{HostLink, POLL_PERIOD_NS, RobotConfig, SERVO_IDS, SimBasicIo, VirtualRobot};
+pub use servo::{Faults, ServoStats, SimServo};
+pub use wire::{Bus, BusByte, SerialLine, StationId};

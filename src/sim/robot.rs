@@ -1,0 +1,425 @@
+//! The whole virtual arm under virtual time: the real Basic and Atom firmware libraries, the
+//! shared bus, seven simulated servos, and the USB serial links of both boards.
+
+use firmware_atom::{Atom, AtomConfig, RecordingIo};
+use firmware_basic::{Basic, BasicConfig, BasicIo, Buttons};
+use protocol_core::timing::{HOST_BAUD, HOST_REPLY_DEADLINE_US};
+use protocol_core::{Frame, FrameDecoder};
+
+use super::servo::SimServo;
+use super::wire::{Bus, SerialLine, SerialPort, StationId};
+
+/// Longest virtual time between two polls of the Basic and the Atom, in ns: one byte time on
+/// the bus, so no station ever misses a byte-time boundary by more than that.
+pub const POLL_PERIOD_NS: u64 = 10_000;
+
+/// Ids of the simulated servos: joints 1..6 and the gripper (7).
+pub const SERVO_IDS: [u8; 7] = [1, 2, 3, 4, 5, 6, 7];
+
+/// How the virtual arm is built. `Default` is the real arm: Basic and Atom both on the bus,
+/// both hearing their own echo (TX and RX tied), servos at 2048 (all joints at 0 degrees).
+#[derive(Clone, Copy, Debug)]
+pub struct RobotConfig {
+    /// Whether the Atom receives its own bus transmissions.
+    pub atom_hears_echo: bool,
+    /// Whether the Basic receives its own bus transmissions.
+    pub basic_hears_echo: bool,
+    /// Whether the Basic is present. Without it the host talks to the Atom's USB port only.
+    pub with_basic: bool,
+    /// Seed of the simulated randomness (what collisions turn bytes into).
+    pub seed: u64,
+    /// The Atom firmware's configuration.
+    pub atom: AtomConfig,
+    /// The Basic firmware's configuration.
+    pub basic: BasicConfig,
+    /// Encoder position of every servo at power-up, in steps (2048 = 0 degrees).
+    pub initial_position_steps: u16,
+}
+
+impl Default for RobotConfig {
+    fn default() -> Self {
+        Self {
+            atom_hears_echo: true,
+            basic_hears_echo: true,
+            with_basic: true,
+            seed: 0x6d79_436f_626f_7421,
+            atom: AtomConfig {
+                powered_at_boot: true,
+                ..AtomConfig::default()
+            },
+            basic: BasicConfig::default(),
+            initial_position_steps: 2048,
+        }
+    }
+}
+
+/// The Basic's pins and sensors in the simulation: outputs remember their level, inputs and
+/// the ToF distance are set by tests.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SimBasicIo {
+    /// Levels of outputs GPIO2 and GPIO5 (in that order).
+    pub outputs: [bool; 2],
+    /// Levels of inputs GPIO35 and GPIO36 (in that order).
+    pub inputs: [bool; 2],
+    /// What the ToF sensor measures, in mm; `None` = no sensor.
+    pub tof_mm: Option<u16>,
+    /// Front buttons held.
+    pub buttons: Buttons,
+}
+
+impl BasicIo for SimBasicIo {
+    fn set_output(&mut self, pin: u8, high: bool) -> bool {
+        let slot = match pin {
+            2 => self.outputs.get_mut(0),
+            5 => self.outputs.get_mut(1),
+            _ => None,
+        };
+        slot.map(|level| *level = high).is_some()
+    }
+
+    fn read_input(&mut self, pin: u8) -> Option<bool> {
+        match pin {
+            35 => self.inputs.first().copied(),
+            36 => self.inputs.get(1).copied(),
+            _ => None,
+        }
+    }
+
+    fn tof_distance_mm(&mut self) -> Option<u16> {
+        self.tof_mm
+    }
+
+    fn buttons(&mut self) -> Buttons {
+        self.buttons
+    }
+}
+
+/// A board's USB serial: what the host sent to it and what it sends to the host.
+#[derive(Clone, Debug)]
+struct UsbLink {
+    to_board: SerialLine,
+    to_host: SerialLine,
+}
+
+impl UsbLink {
+    fn new() -> Self {
+        Self {
+            to_board: SerialLine::new(HOST_BAUD),
+            to_host: SerialLine::new(HOST_BAUD),
+        }
+    }
+
+    fn deliver(&mut self, now_ns: u64) {
+        self.to_board.deliver(now_ns);
+        self.to_host.deliver(now_ns);
+    }
+
+    fn next_event_ns(&self) -> Option<u64> {
+        [self.to_board.next_event_ns(), self.to_host.next_event_ns()]
+            .into_iter()
+            .flatten()
+            .min()
+    }
+
+    fn board_port(&mut self, now_ns: u64) -> SerialPort<'_> {
+        SerialPort {
+            rx: &mut self.to_board,
+            tx: &mut self.to_host,
+            now_ns,
+        }
+    }
+}
+
+struct BasicBoard {
+    firmware: Basic,
+    station: StationId,
+    usb: UsbLink,
+    io: SimBasicIo,
+}
+
+struct SimulatedServo {
+    station: StationId,
+    servo: SimServo,
+}
+
+/// Which USB port a host talks to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HostLink {
+    /// The Basic's USB serial (the normal way; falls silent without a Basic).
+    Basic,
+    /// The Atom's own USB serial (direct host link).
+    AtomUsb,
+}
+
+/// The virtual myCobot 280 M5. See the [module doc](self).
+///
+/// Time only moves in [`VirtualRobot::run_until`] / [`VirtualRobot::run_for`], as fast as the
+/// host computes it. A real-time driver calls `run_until(wall_clock_us)` in a loop.
+pub struct VirtualRobot {
+    now_ns: u64,
+    bus: Bus,
+    basic: Option<BasicBoard>,
+    atom: Atom,
+    atom_station: StationId,
+    atom_usb: UsbLink,
+    atom_io: RecordingIo,
+    servos: Vec<SimulatedServo>,
+    noise_station: StationId,
+    next_poll_ns: u64,
+}
+
+impl VirtualRobot {
+    /// A robot just switched on at time 0: firmware booting, every servo at
+    /// `config.initial_position_steps`.
+    pub fn new(config: RobotConfig) -> Self {
+        let mut bus = Bus::mycobot(config.seed);
+        let basic = config.with_basic.then(|| BasicBoard {
+            firmware: Basic::new(config.basic),
+            station: bus.attach(config.basic_hears_echo),
+            usb: UsbLink::new(),
+            io: SimBasicIo::default(),
+        });
+        let atom_station = bus.attach(config.atom_hears_echo);
+        let servos = SERVO_IDS
+            .iter()
+            .map(|&id| SimulatedServo {
+                station: bus.attach(false),
+                servo: SimServo::new(id, config.initial_position_steps),
+            })
+            .collect();
+        let noise_station = bus.attach(false);
+        Self {
+            now_ns: 0,
+            bus,
+            basic,
+            atom: Atom::new(config.atom),
+            atom_station,
+            atom_usb: UsbLink::new(),
+            atom_io: RecordingIo::default(),
+            servos,
+            noise_station,
+            next_poll_ns: 0,
+        }
+    }
+
+    /// Virtual time since power-up, in microseconds.
+    pub fn now_us(&self) -> u64 {
+        self.now_ns / 1_000
+    }
+
+    /// Virtual time since power-up, in nanoseconds.
+    pub fn now_ns(&self) -> u64 {
+        self.now_ns
+    }
+
+    /// Sends `bytes` from the host into the Basic's USB serial; they arrive at 115200 baud.
+    /// Dropped if the robot has no Basic.
+    pub fn host_write(&mut self, bytes: &[u8]) {
+        self.link_write(HostLink::Basic, bytes);
+    }
+
+    /// Appends to `out` the bytes the Basic sent to the host that have fully arrived.
+    pub fn host_read(&mut self, out: &mut Vec<u8>) {
+        self.link_read(HostLink::Basic, out);
+    }
+
+    /// Sends `bytes` from a host into the Atom's own USB serial.
+    pub fn atom_usb_write(&mut self, bytes: &[u8]) {
+        self.link_write(HostLink::AtomUsb, bytes);
+    }
+
+    /// Appends to `out` the bytes the Atom sent on its own USB serial that have arrived.
+    pub fn atom_usb_read(&mut self, out: &mut Vec<u8>) {
+        self.link_read(HostLink::AtomUsb, out);
+    }
+
+    /// Sends `bytes` from a host into `link`.
+    pub fn link_write(&mut self, link: HostLink, bytes: &[u8]) {
+        let now = self.now_ns;
+        if let Some(usb) = self.usb_mut(link) {
+            usb.to_board.send(now, bytes);
+        }
+    }
+
+    /// Appends to `out` the bytes that arrived at the host on `link`.
+    pub fn link_read(&mut self, link: HostLink, out: &mut Vec<u8>) {
+        if let Some(usb) = self.usb_mut(link) {
+            usb.to_host.receive_all(out);
+        }
+    }
+
+    fn usb_mut(&mut self, link: HostLink) -> Option<&mut UsbLink> {
+        match link {
+            HostLink::Basic => self.basic.as_mut().map(|b| &mut b.usb),
+            HostLink::AtomUsb => Some(&mut self.atom_usb),
+        }
+    }
+
+    /// Puts `bytes` on the bus from a noise source starting now, one per byte time, colliding
+    /// with whatever else is on the wire.
+    pub fn inject_bus_noise(&mut self, bytes: &[u8]) {
+        use protocol_core::BytePort;
+        if let Some(mut port) = self.bus.port(self.noise_station) {
+            port.write(bytes);
+        }
+        self.bus.start_transmissions(self.now_ns);
+    }
+
+    /// Runs the robot until virtual time `t_us` (no-op if that is not in the future).
+    pub fn run_until(&mut self, t_us: u64) {
+        let target = t_us.saturating_mul(1_000);
+        while self.now_ns < target {
+            let next = [
+                Some(self.next_poll_ns),
+                self.bus.next_event_ns(),
+                self.atom_usb.next_event_ns(),
+                self.basic.as_ref().and_then(|b| b.usb.next_event_ns()),
+                self.servos
+                    .iter()
+                    .filter_map(|s| s.servo.next_event_ns())
+                    .min(),
+                Some(target),
+            ]
+            .into_iter()
+            .flatten()
+            .min()
+            .unwrap_or(target)
+            .max(self.now_ns + 1);
+            self.step(next);
+        }
+    }
+
+    /// Runs the robot for `dt_us` more microseconds of virtual time.
+    pub fn run_for(&mut self, dt_us: u64) {
+        self.run_until(self.now_us() + dt_us);
+    }
+
+    /// One instant: bytes that ended arrive, servos react, boards are polled, and every free
+    /// transmitter starts its next byte.
+    fn step(&mut self, now_ns: u64) {
+        self.now_ns = now_ns;
+        self.bus.deliver(now_ns);
+        self.atom_usb.deliver(now_ns);
+        if let Some(basic) = self.basic.as_mut() {
+            basic.usb.deliver(now_ns);
+        }
+        for s in &mut self.servos {
+            if let Some(mut port) = self.bus.port(s.station) {
+                s.servo.poll(now_ns, &mut port);
+            }
+        }
+        let now_us = now_ns / 1_000;
+        if let Some(basic) = self.basic.as_mut()
+            && let Some(mut bus) = self.bus.port(basic.station)
+        {
+            let mut host = basic.usb.board_port(now_ns);
+            basic
+                .firmware
+                .poll(now_us, &mut host, &mut bus, &mut basic.io);
+        }
+        if let Some(mut bus) = self.bus.port(self.atom_station) {
+            let mut usb = self.atom_usb.board_port(now_ns);
+            self.atom
+                .poll(now_us, &mut bus, &mut usb, &mut self.atom_io);
+        }
+        self.bus.start_transmissions(now_ns);
+        self.next_poll_ns = now_ns + POLL_PERIOD_NS;
+    }
+
+    /// Sends `request` to the Basic's USB port and runs until the first complete frame comes
+    /// back or pymycobot's reply deadline (0.5 s) passes. Other bytes before it are skipped.
+    pub fn transact(&mut self, request: &Frame) -> Option<Frame> {
+        self.transact_on(HostLink::Basic, request)
+    }
+
+    /// Like [`VirtualRobot::transact`] on any host link.
+    pub fn transact_on(&mut self, link: HostLink, request: &Frame) -> Option<Frame> {
+        self.link_write(link, &request.to_bytes());
+        let deadline = self.now_us() + HOST_REPLY_DEADLINE_US;
+        let mut decoder = FrameDecoder::new();
+        let mut bytes = Vec::new();
+        while self.now_us() < deadline {
+            // A byte at 115200 takes 87 us: look at what came back once per byte time.
+            self.run_for(87);
+            bytes.clear();
+            self.link_read(link, &mut bytes);
+            for &b in &bytes {
+                if let Some(frame) = decoder.push(b) {
+                    return Some(frame);
+                }
+            }
+        }
+        None
+    }
+
+    /// The simulated servo with bus id `id` (its present register 5).
+    pub fn servo(&self, id: u8) -> Option<&SimServo> {
+        self.servos.iter().map(|s| &s.servo).find(|s| s.id() == id)
+    }
+
+    /// The simulated servo with bus id `id`, to inject faults or move it by hand.
+    pub fn servo_mut(&mut self, id: u8) -> Option<&mut SimServo> {
+        self.servos
+            .iter_mut()
+            .map(|s| &mut s.servo)
+            .find(|s| s.id() == id)
+    }
+
+    /// Every simulated servo, in the order they were built (ids 1..7 at power-up).
+    pub fn servos(&self) -> impl Iterator<Item = &SimServo> {
+        self.servos.iter().map(|s| &s.servo)
+    }
+
+    /// The bus station of the servo built for `id` (for reading a bus trace).
+    pub fn servo_station(&self, id: u8) -> Option<StationId> {
+        self.servos
+            .iter()
+            .find(|s| s.servo.id() == id)
+            .map(|s| s.station)
+    }
+
+    /// The Atom firmware, for inspection.
+    pub fn atom(&self) -> &Atom {
+        &self.atom
+    }
+
+    /// The Atom's bus station (for reading a bus trace).
+    pub fn atom_station(&self) -> StationId {
+        self.atom_station
+    }
+
+    /// The Atom's pins, LEDs and button.
+    pub fn atom_io(&self) -> &RecordingIo {
+        &self.atom_io
+    }
+
+    /// The Atom's pins, LEDs and button, to set inputs or press the button.
+    pub fn atom_io_mut(&mut self) -> &mut RecordingIo {
+        &mut self.atom_io
+    }
+
+    /// The Basic firmware, if the robot has one.
+    pub fn basic(&self) -> Option<&Basic> {
+        self.basic.as_ref().map(|b| &b.firmware)
+    }
+
+    /// The Basic's bus station, if the robot has a Basic.
+    pub fn basic_station(&self) -> Option<StationId> {
+        self.basic.as_ref().map(|b| b.station)
+    }
+
+    /// The Basic's pins and sensors, if the robot has a Basic.
+    pub fn basic_io_mut(&mut self) -> Option<&mut SimBasicIo> {
+        self.basic.as_mut().map(|b| &mut b.io)
+    }
+
+    /// The shared bus, for inspection (collisions, overruns).
+    pub fn bus(&self) -> &Bus {
+        &self.bus
+    }
+
+    /// The shared bus, to switch tracing on and take the trace.
+    pub fn bus_mut(&mut self) -> &mut Bus {
+        &mut self.bus
+    }
+}

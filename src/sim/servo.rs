@@ -1,0 +1,536 @@
+//! A simulated Feetech STS servo (`servo-bus.md`): the control table, the instructions, a
+//! trapezoidal position motion and the faults a test can inject.
+//!
+//! The servo listens to every byte of the bus ([`SimServo::poll`]), obeys instructions for its
+//! id (or the broadcast id), and queues its status reply to start after its return delay
+//! (register 7, in 2 us units) plus [`PROCESSING_NS`]. Its shaft moves in fixed control steps of
+//! [`CONTROL_PERIOD_NS`] towards the goal position with the goal speed and acceleration, and the
+//! present-state registers (56..70) follow.
+//!
+//! Positions: the shaft has a raw encoder position; registers report `raw - homing offset`
+//! (register 31), so writing 128 to torque enable (calibration) makes the present position 2048
+//! without moving anything. While torque is off the shaft stays where it is unless a test moves
+//! it by hand ([`SimServo::move_by_hand`]), and the goal follows the present position so
+//! re-enabling torque holds the arm still.
+
+use std::collections::VecDeque;
+
+use protocol_core::BytePort;
+use protocol_core::servo::{
+    BROADCAST_ID, Instruction, Packet, PacketDecoder, fault, reg, to_sign_magnitude,
+};
+use protocol_core::timing::{BUS_BAUD, wire_time_ns};
+
+/// Time a servo takes to decode an instruction before its return delay starts, in ns. With the
+/// default return delay of 0 the answer starts 12 us after the instruction's last stop bit, well
+/// inside [`protocol_core::timing::SERVO_TURNAROUND_MAX_US`].
+pub const PROCESSING_NS: u64 = 12_000;
+/// Period of the servo's position control loop, in ns (1 kHz, like the STS firmware).
+pub const CONTROL_PERIOD_NS: u64 = 1_000_000;
+/// A gap this long inside a packet means it was cut short; the servo drops the partial packet.
+pub const PACKET_GAP_NS: u64 = 100_000;
+/// Silence between two answers of one SYNC READ, in ns.
+pub const SYNC_READ_SLOT_GAP_NS: u64 = 10_000;
+/// Fastest the shaft turns, in steps per second (STS3215 at 12 V, about 270 deg/s). A goal
+/// speed of 0 means this.
+pub const MAX_SPEED_STEPS_PER_S: f64 = 3_000.0;
+/// One unit of the acceleration register, in steps per second squared.
+pub const ACCEL_UNIT_STEPS_PER_S2: f64 = 100.0;
+/// Acceleration used when the register is 0 ("as fast as possible"), in steps/s^2.
+pub const MAX_ACCEL_STEPS_PER_S2: f64 = 100_000.0;
+/// Present voltage reported, in 0.1 V (the arm's 12 V supply under load).
+pub const SUPPLY_DECIVOLT: u8 = 120;
+/// Temperature of a servo at rest, in deg C.
+pub const AMBIENT_C: u8 = 32;
+/// Temperature an injected overheat reports, in deg C (above the default limit of 70).
+pub const OVERHEAT_C: u8 = 80;
+
+/// First RAM address; below it is EEPROM (write-protected by register 55).
+const FIRST_RAM_ADDR: u8 = reg::TORQUE_ENABLE;
+/// Firmware version and model number reported (STS3215, firmware 3.9).
+const FIRMWARE: (u8, u8) = (3, 9);
+const MODEL_STS3215: u16 = 777;
+
+/// Faults a test can inject into a servo; several may be active at once.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Faults {
+    /// The servo hears nothing and never answers (unplugged, dead, or a broken cable).
+    pub no_answer: bool,
+    /// The servo obeys but every answer has a wrong checksum.
+    pub bad_checksum: bool,
+    /// The shaft is blocked: it never reaches the goal, the load is high and the overload bit
+    /// is set while torque is on.
+    pub stall: bool,
+    /// The servo is too hot: high temperature and the overheat bit.
+    pub overheat: bool,
+}
+
+/// Counters of what a servo did, for tests and benchmarks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ServoStats {
+    /// Instruction packets addressed to this servo (or broadcast) that it obeyed.
+    pub instructions: u64,
+    /// Reads (READ or SYNC READ) that included the present position (register 56).
+    pub position_reads: u64,
+    /// Status packets it queued for sending.
+    pub replies: u64,
+    /// Writes of a goal position (WRITE, REG WRITE + ACTION, SYNC WRITE).
+    pub goal_writes: u64,
+}
+
+/// One simulated STS servo. See the [module doc](self).
+#[derive(Clone, Debug)]
+pub struct SimServo {
+    table: [u8; reg::TABLE_SIZE],
+    raw_position_steps: f64,
+    velocity_steps_per_s: f64,
+    last_control_ns: u64,
+    decoder: PacketDecoder,
+    last_rx_ns: u64,
+    /// Status packets waiting for their start time (ns), in order.
+    replies: VecDeque<(u64, Vec<u8>)>,
+    registered: Option<(u8, Vec<u8>)>,
+    faults: Faults,
+    stats: ServoStats,
+}
+
+impl SimServo {
+    /// A servo with factory settings for `id`, its shaft at encoder position `position`.
+    /// The vendor PID is set per joint: id 4 gets 32/32/0, the others 10/0/1 (`servo-bus.md`).
+    pub fn new(id: u8, position: u16) -> Self {
+        let mut servo = Self {
+            table: [0; reg::TABLE_SIZE],
+            raw_position_steps: f64::from(position.min(4095)),
+            velocity_steps_per_s: 0.0,
+            last_control_ns: 0,
+            decoder: PacketDecoder::new(),
+            last_rx_ns: 0,
+            replies: VecDeque::new(),
+            registered: None,
+            faults: Faults::default(),
+            stats: ServoStats::default(),
+        };
+        servo.factory_reset(id);
+        servo
+    }
+
+    fn factory_reset(&mut self, id: u8) {
+        let mut t = [0u8; reg::TABLE_SIZE];
+        let mut set = |addr: u8, bytes: &[u8]| {
+            for (i, &b) in bytes.iter().enumerate() {
+                if let Some(slot) = t.get_mut(usize::from(addr) + i) {
+                    *slot = b;
+                }
+            }
+        };
+        set(reg::FIRMWARE_MAJOR, &[FIRMWARE.0, FIRMWARE.1]);
+        set(reg::MODEL, &MODEL_STS3215.to_le_bytes());
+        set(reg::ID, &[id]);
+        set(reg::BAUD_RATE, &[0]);
+        set(reg::RETURN_DELAY, &[0]);
+        set(reg::STATUS_RETURN_LEVEL, &[1]);
+        set(reg::MIN_POSITION, &0u16.to_le_bytes());
+        set(reg::MAX_POSITION, &4095u16.to_le_bytes());
+        set(reg::MAX_TEMPERATURE, &[70]);
+        set(reg::MAX_VOLTAGE, &[140]);
+        set(reg::MIN_VOLTAGE, &[40]);
+        set(reg::MAX_TORQUE, &1000u16.to_le_bytes());
+        set(reg::UNLOADING_CONDITION, &[44]);
+        set(reg::LED_ALARM, &[47]);
+        let pid: [u8; 3] = if id == 4 { [32, 32, 0] } else { [10, 0, 1] };
+        set(reg::P_COEFFICIENT, &pid);
+        set(reg::MIN_STARTUP_FORCE, &16u16.to_le_bytes());
+        set(reg::CW_DEAD_ZONE, &[1, 1]);
+        set(reg::HOMING_OFFSET, &0u16.to_le_bytes());
+        set(reg::OPERATING_MODE, &[0]);
+        set(reg::OVERLOAD_TORQUE, &[80]);
+        set(reg::TORQUE_ENABLE, &[0]);
+        set(reg::ACCELERATION, &[0]);
+        set(reg::TORQUE_LIMIT, &1000u16.to_le_bytes());
+        set(reg::EEPROM_LOCK, &[1]);
+        self.table = t;
+        let present = self.present_position();
+        self.set_u16(reg::GOAL_POSITION, present);
+        self.update_present_registers();
+    }
+
+    /// The servo's current id (register 5).
+    pub fn id(&self) -> u8 {
+        self.reg(reg::ID)
+    }
+
+    /// One byte of the control table.
+    pub fn reg(&self, addr: u8) -> u8 {
+        self.table.get(usize::from(addr)).copied().unwrap_or(0)
+    }
+
+    /// A little-endian two-byte register (raw, sign-magnitude values undecoded).
+    pub fn reg_u16(&self, addr: u8) -> u16 {
+        u16::from_le_bytes([self.reg(addr), self.reg(addr.wrapping_add(1))])
+    }
+
+    /// Present position in steps (register 56): the shaft minus the homing offset, 0..4095.
+    pub fn present_position(&self) -> u16 {
+        let raw = self.raw_position_steps.round() as i32;
+        (raw - self.homing_offset()).rem_euclid(4096) as u16
+    }
+
+    /// The goal position register, in steps.
+    pub fn goal_position(&self) -> u16 {
+        self.reg_u16(reg::GOAL_POSITION)
+    }
+
+    /// True while torque is enabled (register 40).
+    pub fn torque_enabled(&self) -> bool {
+        self.reg(reg::TORQUE_ENABLE) != 0
+    }
+
+    /// True while the shaft is moving or has not reached its goal (register 66).
+    pub fn is_moving(&self) -> bool {
+        self.reg(reg::MOVING) != 0
+    }
+
+    /// Active injected faults.
+    pub fn faults(&self) -> Faults {
+        self.faults
+    }
+
+    /// Replaces the injected faults (take effect at once).
+    pub fn set_faults(&mut self, faults: Faults) {
+        self.faults = faults;
+        if faults.no_answer {
+            self.replies.clear();
+        }
+        self.update_present_registers();
+    }
+
+    /// What this servo did so far.
+    pub fn stats(&self) -> ServoStats {
+        self.stats
+    }
+
+    /// Turns the shaft by hand to present position `position` (steps), as a user does in free
+    /// mode. Works with torque on too (the servo then pulls back towards its goal).
+    pub fn move_by_hand(&mut self, position: u16) {
+        self.raw_position_steps = f64::from(i32::from(position.min(4095)) + self.homing_offset());
+        self.velocity_steps_per_s = 0.0;
+        if !self.torque_enabled() {
+            self.set_u16(reg::GOAL_POSITION, self.present_position());
+        }
+        self.update_present_registers();
+    }
+
+    /// The next instant this servo has something to do on the bus (a reply to start), in ns.
+    pub fn next_event_ns(&self) -> Option<u64> {
+        self.replies.front().map(|(t, _)| *t)
+    }
+
+    /// Runs the servo up to `now_ns`: moves the shaft, takes the bytes it heard on `port`
+    /// (call this at every byte end, so each byte is heard at its own time), and queues on
+    /// `port` the replies due by now.
+    pub fn poll(&mut self, now_ns: u64, port: &mut impl BytePort) {
+        self.advance(now_ns);
+        if self.faults.no_answer {
+            while port.read_byte().is_some() {}
+            self.decoder = PacketDecoder::new();
+            return;
+        }
+        let mut heard = false;
+        while let Some(byte) = port.read_byte() {
+            if !heard && now_ns.saturating_sub(self.last_rx_ns) >= PACKET_GAP_NS {
+                let mut cut = self.decoder.on_quiet_line();
+                while let Some(p) = cut {
+                    self.obey(&p, now_ns);
+                    cut = self.decoder.next_packet();
+                }
+            }
+            heard = true;
+            let mut found = self.decoder.push(byte);
+            while let Some(p) = found {
+                self.obey(&p, now_ns);
+                found = self.decoder.next_packet();
+            }
+        }
+        if heard {
+            self.last_rx_ns = now_ns;
+        }
+        while let Some((_, bytes)) = self.replies.pop_front_if(|(t, _)| *t <= now_ns) {
+            port.write(&bytes);
+        }
+    }
+
+    /// Moves the shaft in control steps up to `now_ns`.
+    pub fn advance(&mut self, now_ns: u64) {
+        while self.last_control_ns + CONTROL_PERIOD_NS <= now_ns {
+            self.last_control_ns += CONTROL_PERIOD_NS;
+            self.control_step(CONTROL_PERIOD_NS as f64 / 1e9);
+        }
+    }
+
+    fn control_step(&mut self, dt_s: f64) {
+        let goal = f64::from(i32::from(self.goal_position()) + self.homing_offset());
+        if !self.torque_enabled() {
+            // Free: the goal follows the shaft, so enabling torque holds it where it is.
+            self.velocity_steps_per_s = 0.0;
+            let present = self.present_position();
+            self.set_u16(reg::GOAL_POSITION, present);
+        } else if self.faults.stall {
+            self.velocity_steps_per_s = 0.0;
+        } else {
+            let speed = match self.reg_u16(reg::GOAL_SPEED) & 0x7FFF {
+                0 => MAX_SPEED_STEPS_PER_S,
+                s => f64::from(s).min(MAX_SPEED_STEPS_PER_S),
+            };
+            let accel = match self.reg(reg::ACCELERATION) {
+                0 => MAX_ACCEL_STEPS_PER_S2,
+                a => f64::from(a) * ACCEL_UNIT_STEPS_PER_S2,
+            };
+            let error = goal - self.raw_position_steps;
+            let v = self.velocity_steps_per_s;
+            let braking = v * v / (2.0 * accel);
+            // Speed we want now: towards the goal, capped so that we can still stop in time.
+            let wanted = error.signum() * speed.min((2.0 * accel * error.abs()).sqrt());
+            let dv = (wanted - v).clamp(-accel * dt_s, accel * dt_s);
+            let mut v_next = v + dv;
+            if error.abs() <= 0.5 && v.abs() <= accel * dt_s {
+                v_next = 0.0;
+            }
+            let step = (v + v_next) / 2.0 * dt_s;
+            if step.abs() >= error.abs() && braking <= error.abs() + 1.0 {
+                // Arrives within this step.
+                self.raw_position_steps = goal;
+                self.velocity_steps_per_s = 0.0;
+            } else {
+                self.raw_position_steps += step;
+                self.velocity_steps_per_s = v_next;
+            }
+        }
+        self.update_present_registers();
+    }
+
+    fn homing_offset(&self) -> i32 {
+        i32::from(protocol_core::servo::sign_magnitude(
+            self.reg_u16(reg::HOMING_OFFSET),
+            11,
+        ))
+    }
+
+    fn set_u16(&mut self, addr: u8, value: u16) {
+        let [lo, hi] = value.to_le_bytes();
+        self.set_reg(addr, lo);
+        self.set_reg(addr.wrapping_add(1), hi);
+    }
+
+    fn set_reg(&mut self, addr: u8, value: u8) {
+        if let Some(slot) = self.table.get_mut(usize::from(addr)) {
+            *slot = value;
+        }
+    }
+
+    fn update_present_registers(&mut self) {
+        let torque = self.torque_enabled();
+        let stalled = self.faults.stall && torque;
+        let goal = self.goal_position();
+        let present = self.present_position();
+        let speed = self.velocity_steps_per_s.round() as i16;
+        let load_permille: i16 = if stalled {
+            980
+        } else if !torque {
+            0
+        } else if speed != 0 {
+            180
+        } else {
+            40
+        };
+        let direction = if stalled {
+            i16::from(goal >= present) * 2 - 1
+        } else if speed < 0 {
+            -1
+        } else {
+            1
+        };
+        let moving = torque && (speed != 0 || goal.abs_diff(present) > 1);
+        let mut status = 0;
+        if stalled {
+            status |= fault::OVERLOAD;
+        }
+        if self.faults.overheat {
+            status |= fault::OVERHEAT;
+        }
+        self.set_u16(reg::PRESENT_POSITION, present);
+        self.set_u16(reg::PRESENT_SPEED, to_sign_magnitude(speed, 15));
+        self.set_u16(
+            reg::PRESENT_LOAD,
+            to_sign_magnitude(direction * load_permille, 10),
+        );
+        self.set_reg(reg::PRESENT_VOLTAGE, SUPPLY_DECIVOLT);
+        self.set_reg(
+            reg::PRESENT_TEMPERATURE,
+            if self.faults.overheat {
+                OVERHEAT_C
+            } else {
+                AMBIENT_C + u8::from(stalled) * 8
+            },
+        );
+        self.set_reg(reg::STATUS, status);
+        self.set_reg(reg::MOVING, u8::from(moving));
+        // About 6.5 mA per unit; the current follows the load.
+        self.set_u16(
+            reg::PRESENT_CURRENT,
+            to_sign_magnitude(direction * load_permille / 2, 15),
+        );
+    }
+
+    /// Carries out one packet heard at `now_ns` (its last byte ended then).
+    fn obey(&mut self, packet: &Packet, now_ns: u64) {
+        let id = self.id();
+        let broadcast = packet.id() == BROADCAST_ID;
+        if packet.id() != id && !broadcast {
+            return;
+        }
+        let Ok(instr) = Instruction::parse(packet) else {
+            return;
+        };
+        self.stats.instructions += 1;
+        let answers_all = self.reg(reg::STATUS_RETURN_LEVEL) >= 1 && !broadcast;
+        match instr {
+            Instruction::Ping => self.reply(now_ns, &[], !broadcast),
+            Instruction::Read { addr, count } => {
+                self.note_read(addr, count);
+                let data = self.read_block(addr, count);
+                self.reply(now_ns, &data, !broadcast);
+            }
+            Instruction::Write { addr, data } => {
+                self.write_block(addr, data);
+                self.reply(now_ns, &[], answers_all);
+            }
+            Instruction::RegWrite { addr, data } => {
+                self.registered = Some((addr, data.to_vec()));
+                self.reply(now_ns, &[], answers_all);
+            }
+            Instruction::Action => {
+                if let Some((addr, data)) = self.registered.take() {
+                    self.write_block(addr, &data);
+                }
+                self.reply(now_ns, &[], answers_all);
+            }
+            Instruction::Reset => {
+                self.factory_reset(id);
+                self.reply(now_ns, &[], answers_all);
+            }
+            Instruction::SyncRead { addr, count, ids } => {
+                if let Some(slot) = ids.iter().position(|&i| i == id) {
+                    self.note_read(addr, count);
+                    let data = self.read_block(addr, count);
+                    let answer_ns = wire_time_ns(6 + u32::from(count), BUS_BAUD);
+                    let delay = slot as u64 * (answer_ns + SYNC_READ_SLOT_GAP_NS);
+                    self.reply(now_ns + delay, &data, true);
+                }
+            }
+            Instruction::SyncWrite { addr, .. } => {
+                if let Some(data) = instr.sync_write_data_for(id) {
+                    self.write_block(addr, data);
+                }
+            }
+        }
+    }
+
+    fn note_read(&mut self, addr: u8, count: u8) {
+        if (addr..addr.saturating_add(count)).contains(&reg::PRESENT_POSITION) {
+            self.stats.position_reads += 1;
+        }
+    }
+
+    /// Queues a status packet (if `send`), starting after the return delay.
+    fn reply(&mut self, heard_ns: u64, data: &[u8], send: bool) {
+        if !send {
+            return;
+        }
+        let err = self.reg(reg::STATUS);
+        let Some(packet) = Packet::new(self.id(), err, data) else {
+            return;
+        };
+        let mut bytes = packet.to_bytes().to_vec();
+        if self.faults.bad_checksum
+            && let Some(chk) = bytes.last_mut()
+        {
+            *chk ^= 0x5A;
+        }
+        let start = heard_ns + PROCESSING_NS + u64::from(self.reg(reg::RETURN_DELAY)) * 2_000;
+        self.replies.push_back((start, bytes));
+        self.stats.replies += 1;
+    }
+
+    fn read_block(&self, addr: u8, count: u8) -> Vec<u8> {
+        (0..count).map(|i| self.reg(addr.wrapping_add(i))).collect()
+    }
+
+    fn write_block(&mut self, addr: u8, data: &[u8]) {
+        let locked = self.reg(reg::EEPROM_LOCK) != 0;
+        let mut goal_written = false;
+        for (i, &value) in data.iter().enumerate() {
+            let Some(a) = u8::try_from(usize::from(addr) + i)
+                .ok()
+                .filter(|&a| usize::from(a) < reg::TABLE_SIZE)
+            else {
+                break;
+            };
+            match a {
+                reg::FIRMWARE_MAJOR..=4 => {}
+                reg::PRESENT_POSITION.. => {}
+                a if a < FIRST_RAM_ADDR && locked => {}
+                reg::TORQUE_ENABLE => self.write_torque(value),
+                reg::GOAL_POSITION | 43 => {
+                    self.set_reg(a, value);
+                    goal_written = true;
+                }
+                reg::EEPROM_LOCK => self.set_reg(a, u8::from(value != 0)),
+                _ => self.set_reg(a, value),
+            }
+        }
+        if goal_written {
+            self.stats.goal_writes += 1;
+            let min = self.reg_u16(reg::MIN_POSITION);
+            let max = self.reg_u16(reg::MAX_POSITION);
+            let goal = self.goal_position() & 0x0FFF;
+            if min < max {
+                self.set_u16(reg::GOAL_POSITION, goal.clamp(min, max));
+            } else {
+                self.set_u16(reg::GOAL_POSITION, goal);
+            }
+        }
+        self.update_present_registers();
+    }
+
+    fn write_torque(&mut self, value: u8) {
+        match value {
+            128 => {
+                // Calibration: the shaft's present position becomes 2048.
+                let raw = self.raw_position_steps.round() as i32;
+                let offset = (raw - 2048).clamp(-2047, 2047) as i16;
+                self.set_u16(reg::HOMING_OFFSET, to_sign_magnitude(offset, 11));
+                let present = self.present_position();
+                self.set_u16(reg::GOAL_POSITION, present);
+            }
+            0 => {
+                self.set_reg(reg::TORQUE_ENABLE, 0);
+                self.velocity_steps_per_s = 0.0;
+                let present = self.present_position();
+                self.set_u16(reg::GOAL_POSITION, present);
+            }
+            v => {
+                if !self.torque_enabled() {
+                    let present = self.present_position();
+                    self.set_u16(reg::GOAL_POSITION, present);
+                }
+                self.set_reg(reg::TORQUE_ENABLE, v.min(2));
+            }
+        }
+    }
+}
+
+impl Default for SimServo {
+    fn default() -> Self {
+        Self::new(1, 2048)
+    }
+}
