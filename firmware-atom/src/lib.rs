@@ -9,9 +9,13 @@
 #![forbid(unsafe_code)]
 
 mod atom;
+pub mod bus;
 pub mod config;
+pub mod driver;
 pub mod health;
 pub mod io;
+pub mod motion;
+pub mod safety;
 
 pub use atom::Atom;
 pub use config::{AtomConfig, ConfigError, JointLimit, JointSign, TimingBudget};

@@ -1,0 +1,168 @@
+//! [`AtomIo`] on the chip: the user pins as GPIO or LEDC PWM, the RGB LEDs, the button.
+
+use esp_hal::{
+    gpio::{DriveMode, Flex, Input, InputConfig, Level, NoPin, OutputSignal, Pull},
+    ledc::{
+        LowSpeed,
+        channel::{self, ChannelHW, ChannelIFace},
+        timer::{self, LSClockSource, Timer, TimerIFace},
+    },
+    time::Rate,
+};
+use firmware_atom::io::{AtomIo, OUTPUT_PINS, PinMode};
+
+use crate::leds::Leds;
+
+/// Widest PWM duty resolution used, in bits (the widest every LEDC version supports).
+const MAX_DUTY_BITS: u32 = 14;
+/// LEDC low-speed timer clock (APB), in Hz.
+const LEDC_CLOCK_HZ: u32 = 80_000_000;
+
+/// One user pin: its GPIO and the LEDC timer, channel and signal reserved for its PWM.
+pub struct UserPin<'d> {
+    /// The pin itself.
+    pub gpio: Flex<'d>,
+    /// The LEDC timer that sets this pin's PWM frequency.
+    pub timer: Timer<'d, LowSpeed>,
+    /// The LEDC channel that generates this pin's PWM.
+    pub channel: channel::Number,
+    /// That channel's output signal, routed to the pin while PWM is on.
+    pub signal: OutputSignal,
+}
+
+/// The Atom's board IO.
+pub struct BoardIo<'d> {
+    /// The user pins, in the order of [`OUTPUT_PINS`].
+    user: [UserPin<'d>; 4],
+    /// Which user pins currently output PWM.
+    pwm_on: [bool; 4],
+    leds: Option<Leds<'d>>,
+    button: Input<'d>,
+}
+
+impl<'d> BoardIo<'d> {
+    /// Takes the user pins (ordered like [`OUTPUT_PINS`]), the LEDs (if the RMT could drive
+    /// them) and the button. User pins start as floating inputs, as after reset.
+    pub fn new(mut user: [UserPin<'d>; 4], leds: Option<Leds<'d>>, button: Input<'d>) -> Self {
+        for pin in &mut user {
+            make_input(&mut pin.gpio, Pull::None);
+        }
+        Self {
+            user,
+            pwm_on: [false; 4],
+            leds,
+            button,
+        }
+    }
+
+    /// The user pin with protocol number `pin`, and whether it outputs PWM.
+    fn user_pin(&mut self, pin: u8) -> Option<(&mut UserPin<'d>, &mut bool)> {
+        let index = OUTPUT_PINS.iter().position(|&p| p == pin)?;
+        Some((self.user.get_mut(index)?, self.pwm_on.get_mut(index)?))
+    }
+
+    /// Gives `pin` back to the GPIO driver if it was outputting PWM.
+    fn stop_pwm(pin: &mut UserPin<'d>, pwm_on: &mut bool) {
+        if *pwm_on {
+            pin.signal.disconnect_from(&pin.gpio);
+            *pwm_on = false;
+        }
+    }
+}
+
+fn make_input(gpio: &mut Flex<'_>, pull: Pull) {
+    gpio.set_output_enable(false);
+    gpio.apply_input_config(&InputConfig::default().with_pull(pull));
+    gpio.set_input_enable(true);
+}
+
+/// The duty resolution for a PWM frequency: as fine as the 80 MHz clock allows, at most
+/// [`MAX_DUTY_BITS`]. `None` for 0 Hz or frequencies too high for even 1 bit.
+fn duty_bits(freq_hz: u16) -> Option<u32> {
+    let ticks_per_period = LEDC_CLOCK_HZ.checked_div(u32::from(freq_hz))?;
+    let bits = ticks_per_period.checked_ilog2()?.min(MAX_DUTY_BITS);
+    (bits >= 1).then_some(bits)
+}
+
+impl AtomIo for BoardIo<'_> {
+    fn set_pin_mode(&mut self, pin: u8, mode: PinMode) -> bool {
+        let Some((user, pwm_on)) = self.user_pin(pin) else {
+            return false;
+        };
+        Self::stop_pwm(user, pwm_on);
+        match mode {
+            PinMode::Input => make_input(&mut user.gpio, Pull::None),
+            PinMode::InputPullUp => make_input(&mut user.gpio, Pull::Up),
+            PinMode::Output => {
+                user.gpio.set_level(Level::Low);
+                user.gpio.set_output_enable(true);
+            }
+        }
+        true
+    }
+
+    fn write_pin(&mut self, pin: u8, high: bool) -> bool {
+        let Some((user, pwm_on)) = self.user_pin(pin) else {
+            return false;
+        };
+        Self::stop_pwm(user, pwm_on);
+        user.gpio.set_level(Level::from(high));
+        user.gpio.set_output_enable(true);
+        true
+    }
+
+    fn read_pin(&mut self, pin: u8) -> Option<bool> {
+        if pin == firmware_atom::io::BUTTON_PIN {
+            return Some(self.button.is_high());
+        }
+        let (user, _) = self.user_pin(pin)?;
+        // The input buffer stays on in every mode, so an output reads back its own level.
+        user.gpio.set_input_enable(true);
+        Some(user.gpio.is_high())
+    }
+
+    fn set_pwm(&mut self, pin: u8, freq_hz: u16, duty_0_255: u8) -> bool {
+        let Some(bits) = duty_bits(freq_hz) else {
+            return false;
+        };
+        let Ok(duty) = timer::config::Duty::try_from(bits) else {
+            return false;
+        };
+        let Some((user, pwm_on)) = self.user_pin(pin) else {
+            return false;
+        };
+        let timer_config = timer::config::Config {
+            duty,
+            clock_source: LSClockSource::APBClk,
+            frequency: Rate::from_hz(u32::from(freq_hz)),
+        };
+        if user.timer.configure(timer_config).is_err() {
+            return false;
+        }
+        // The channel's signal is routed to the pin by hand below, so the driver gets no pin.
+        let mut pwm = channel::Channel::new(user.channel, NoPin);
+        let channel_config = channel::config::Config {
+            timer: &user.timer,
+            duty_pct: 0,
+            drive_mode: DriveMode::PushPull,
+        };
+        if pwm.configure(channel_config).is_err() {
+            return false;
+        }
+        pwm.set_duty_hw((u32::from(duty_0_255) << bits) / 255);
+        user.signal.connect_to(&user.gpio);
+        user.gpio.set_output_enable(true);
+        *pwm_on = true;
+        true
+    }
+
+    fn set_rgb(&mut self, red: u8, green: u8, blue: u8) {
+        if let Some(leds) = &mut self.leds {
+            leds.fill(red, green, blue);
+        }
+    }
+
+    fn button_pressed(&mut self) -> bool {
+        self.button.is_low()
+    }
+}

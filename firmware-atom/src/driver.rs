@@ -1,0 +1,199 @@
+//! The servo driver: one transaction at a time on the shared bus, each with a deadline.
+//!
+//! A transaction is one instruction packet and, for PING and READ, the one status packet that
+//! answers it. The driver sends the instruction, matches the answer by servo id and reports
+//! the outcome; retries and the gap between transactions are the caller's scheduling decision
+//! ([`crate::Atom`] retries a bounded number of times and waits
+//! [`ATOM_TRANSACTION_GAP_US`](protocol_core::timing::ATOM_TRANSACTION_GAP_US) of silence).
+
+use heapless::Vec;
+use protocol_core::BytePort;
+use protocol_core::servo::{BROADCAST_ID, Instruction, Packet};
+use protocol_core::timing::{BUS_BAUD, SERVO_TURNAROUND_MAX_US, wire_time_us};
+
+use crate::bus::BusReceiver;
+
+/// Most data bytes one WRITE carries: the 7-byte move block is the largest the Atom writes.
+pub const MAX_WRITE: usize = 8;
+
+/// One servo transaction.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Op {
+    /// Is servo `id` there?
+    Ping {
+        /// Servo id.
+        id: u8,
+    },
+    /// Read `count` bytes at `addr` of servo `id`.
+    Read {
+        /// Servo id.
+        id: u8,
+        /// First register.
+        addr: u8,
+        /// Number of bytes.
+        count: u8,
+    },
+    /// Write `data` at `addr` of servo `id`. The answer is optional (status return level 0
+    /// servos stay silent): its absence is not an error.
+    Write {
+        /// Servo id.
+        id: u8,
+        /// First register.
+        addr: u8,
+        /// Bytes to write.
+        data: Vec<u8, MAX_WRITE>,
+    },
+    /// A broadcast instruction (SYNC WRITE): nobody answers.
+    Broadcast(Packet),
+}
+
+impl Op {
+    /// A WRITE of `data` at `addr`; `None` if `data` is longer than [`MAX_WRITE`].
+    pub fn write(id: u8, addr: u8, data: &[u8]) -> Option<Self> {
+        Some(Self::Write {
+            id,
+            addr,
+            data: Vec::from_slice(data).ok()?,
+        })
+    }
+
+    /// The servo this transaction addresses ([`BROADCAST_ID`] for a broadcast).
+    pub fn id(&self) -> u8 {
+        match self {
+            Self::Ping { id } | Self::Read { id, .. } | Self::Write { id, .. } => *id,
+            Self::Broadcast(_) => BROADCAST_ID,
+        }
+    }
+
+    fn packet(&self) -> Option<Packet> {
+        match self {
+            Self::Ping { id } => Instruction::Ping.to_packet(*id),
+            Self::Read { id, addr, count } => Instruction::Read {
+                addr: *addr,
+                count: *count,
+            }
+            .to_packet(*id),
+            Self::Write { id, addr, data } => Instruction::Write { addr: *addr, data }.to_packet(*id),
+            Self::Broadcast(p) => Some(p.clone()),
+        }
+    }
+
+    /// Number of data bytes the answer carries, if one is expected.
+    fn answer_data_len(&self) -> Option<u8> {
+        match self {
+            Self::Ping { .. } => Some(0),
+            Self::Read { count, .. } => Some(*count),
+            Self::Write { id, .. } if *id != BROADCAST_ID => Some(0),
+            Self::Write { .. } | Self::Broadcast(_) => None,
+        }
+    }
+
+    fn answer_required(&self) -> bool {
+        matches!(self, Self::Ping { .. } | Self::Read { .. })
+    }
+}
+
+/// How a transaction ended.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// The servo answered (PING, READ, WRITE with status return level 1).
+    Answered(Packet),
+    /// Done without an answer (broadcast, or a WRITE to a silent servo).
+    Sent,
+    /// The servo did not answer with a valid packet before the deadline.
+    TimedOut,
+}
+
+/// The transaction in flight.
+#[derive(Clone, Debug)]
+struct InFlight {
+    op: Op,
+    deadline_us: u64,
+}
+
+/// Runs one servo transaction at a time.
+#[derive(Clone, Debug, Default)]
+pub struct ServoDriver {
+    in_flight: Option<InFlight>,
+    reply_margin_us: u64,
+}
+
+impl ServoDriver {
+    /// A driver that allows `reply_margin_us` beyond the computed answer time.
+    pub fn new(reply_margin_us: u64) -> Self {
+        Self {
+            in_flight: None,
+            reply_margin_us,
+        }
+    }
+
+    /// True while a transaction is in flight.
+    pub fn busy(&self) -> bool {
+        self.in_flight.is_some()
+    }
+
+    /// Sends `op`'s instruction at `now_us`. `false` (and nothing sent) if a transaction is
+    /// already in flight or the op cannot be encoded.
+    pub fn start<B: BytePort>(
+        &mut self,
+        now_us: u64,
+        op: Op,
+        bus: &mut B,
+        rx: &mut BusReceiver,
+    ) -> bool {
+        if self.busy() {
+            return false;
+        }
+        let Some(packet) = op.packet() else {
+            return false;
+        };
+        let bytes = packet.to_bytes();
+        bus.write(&bytes);
+        rx.on_transmit(now_us, &bytes);
+        let tx_us = wire_time_us(bytes.len() as u32, BUS_BAUD);
+        let answer_us = op
+            .answer_data_len()
+            .map(|n| SERVO_TURNAROUND_MAX_US + wire_time_us(u32::from(n) + 6, BUS_BAUD))
+            .unwrap_or(0);
+        self.in_flight = Some(InFlight {
+            op,
+            deadline_us: now_us + tx_us + answer_us + self.reply_margin_us,
+        });
+        true
+    }
+
+    /// Offers a received servo packet; returns the finished transaction if it answers it.
+    pub fn on_packet(&mut self, packet: Packet) -> Option<(Op, Outcome)> {
+        let flight = self.in_flight.as_ref()?;
+        if flight.op.answer_data_len().is_none() || packet.id() != flight.op.id() {
+            return None;
+        }
+        if let Op::Read { count, .. } = flight.op
+            && packet.params().len() != usize::from(count)
+        {
+            return None;
+        }
+        let flight = self.in_flight.take()?;
+        Some((flight.op, Outcome::Answered(packet)))
+    }
+
+    /// Ends the transaction in flight if its time is up: a broadcast once it has left the
+    /// transmitter, an answerable one at its deadline.
+    pub fn poll<B: BytePort>(&mut self, now_us: u64, bus: &B) -> Option<(Op, Outcome)> {
+        let flight = self.in_flight.as_ref()?;
+        let done = match flight.op.answer_data_len() {
+            None => bus.tx_idle() || now_us >= flight.deadline_us,
+            Some(_) => now_us >= flight.deadline_us,
+        };
+        if !done {
+            return None;
+        }
+        let flight = self.in_flight.take()?;
+        let outcome = if flight.op.answer_required() {
+            Outcome::TimedOut
+        } else {
+            Outcome::Sent
+        };
+        Some((flight.op, outcome))
+    }
+}

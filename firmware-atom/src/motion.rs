@@ -1,0 +1,152 @@
+//! Motion planning: how fast each servo must go so that a joint-interpolated move arrives
+//! everywhere at once, and what the robot is currently doing.
+
+use protocol_core::units::{Centideg, Steps};
+
+use crate::config::{AtomConfig, JOINTS, STEPS_PER_TURN};
+use crate::safety::{Goal, GoalSet};
+
+/// Joint-angle tolerance of "is in position" and of the end of a move: one degree, a little
+/// more than the servo's dead band plus one encoder step.
+pub const IN_POSITION_CENTIDEG: i32 = 100;
+
+/// A move waits at most this long beyond its planned duration before it is declared done
+/// (a stalled or missing servo must not block the queue forever).
+pub const MOVE_OVERTIME_US: u64 = 2_000_000;
+
+/// Steps per second of a joint speed in centidegrees per second.
+pub fn centideg_to_steps(centideg: u32) -> u32 {
+    (u64::from(centideg) * STEPS_PER_TURN as u64 / 36_000) as u32
+}
+
+/// The fastest joint speed at `speed_percent`, steps per second (at least 1).
+pub fn joint_speed_steps(config: &AtomConfig, speed_percent: u8) -> u32 {
+    let pct = u32::from(speed_percent.clamp(1, 100));
+    (centideg_to_steps(config.motion.joint_speed_centideg_per_s) * pct / 100).max(1)
+}
+
+/// The acceleration register value of the fastest joint (100 steps/s^2 units, 1..=254).
+pub fn joint_accel_register(config: &AtomConfig) -> u8 {
+    (centideg_to_steps(config.motion.joint_accel_centideg_per_s2) / 100).clamp(1, 254) as u8
+}
+
+/// A joint-interpolated move from `present` to `target`: every joint's speed and acceleration
+/// are scaled by its share of the longest travel, so that all joints start and arrive together.
+/// Returns the goals (gripper untouched) and the planned duration in microseconds.
+pub fn plan_joint_move(
+    config: &AtomConfig,
+    present: &[Steps; JOINTS],
+    target: &[Option<Steps>; JOINTS],
+    speed_percent: u8,
+) -> (GoalSet, u64) {
+    let travel = |j: usize| -> u32 {
+        match (target.get(j).copied().flatten(), present.get(j)) {
+            (Some(t), Some(p)) => (i32::from(t.0) - i32::from(p.0)).unsigned_abs(),
+            _ => 0,
+        }
+    };
+    let longest = (0..JOINTS).map(travel).max().unwrap_or(0).max(1);
+    let v_max = joint_speed_steps(config, speed_percent);
+    let a_max = u32::from(joint_accel_register(config));
+    let mut goals: GoalSet = [None; crate::config::SERVOS];
+    for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
+        if let Some(position) = target.get(j).copied().flatten() {
+            let share = travel(j);
+            *slot = Some(Goal {
+                position,
+                speed_steps_per_s: (v_max * share / longest).clamp(1, u32::from(u16::MAX)) as u16,
+                accel: (a_max * share / longest).clamp(1, 254) as u8,
+            });
+        }
+    }
+    // Trapezoid: travel / v + v / a (the ramp up and down add one ramp's time).
+    let accel_steps = a_max * 100;
+    let duration_us = u64::from(longest) * 1_000_000 / u64::from(v_max)
+        + u64::from(v_max) * 1_000_000 / u64::from(accel_steps.max(1));
+    (goals, duration_us)
+}
+
+/// True if every joint of `present` is within [`IN_POSITION_CENTIDEG`] of `target`.
+pub fn angles_match(present: &[Centideg; JOINTS], target: &[Centideg; JOINTS]) -> bool {
+    present
+        .iter()
+        .zip(target)
+        .all(|(p, t)| (i32::from(p.0) - i32::from(t.0)).abs() <= IN_POSITION_CENTIDEG)
+}
+
+/// A continuous jog direction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JogDirection {
+    /// Toward smaller values.
+    Negative,
+    /// Toward larger values.
+    Positive,
+}
+
+impl JogDirection {
+    /// +1 or -1.
+    pub fn sign(self) -> i32 {
+        match self {
+            Self::Negative => -1,
+            Self::Positive => 1,
+        }
+    }
+}
+
+/// What the arm is doing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Activity {
+    /// Holding still.
+    Idle,
+    /// A joint-interpolated move toward `target`, planned to take `duration_us` from
+    /// `started_us`.
+    Moving {
+        /// Joint targets.
+        target: [Centideg; JOINTS],
+        /// When the goals were sent.
+        started_us: u64,
+        /// Planned duration.
+        duration_us: u64,
+        /// A continuous jog, stopped by the watchdog when the host goes silent.
+        jog: bool,
+    },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn joints_are_scaled_to_arrive_together() {
+        let cfg = AtomConfig::default();
+        let present = [Steps(2048); JOINTS];
+        let target = [
+            Some(Steps(3048)),
+            Some(Steps(1548)),
+            Some(Steps(2048)),
+            None,
+            Some(Steps(2298)),
+            Some(Steps(2048)),
+        ];
+        let (goals, duration) = plan_joint_move(&cfg, &present, &target, 100);
+        let speed = |j: usize| u32::from(goals[j].unwrap().speed_steps_per_s);
+        let v_max = joint_speed_steps(&cfg, 100);
+        assert_eq!(speed(0), v_max);
+        assert_eq!(speed(1), v_max / 2);
+        assert_eq!(speed(4), v_max / 4);
+        assert_eq!(speed(2), 1, "a joint that stays put never gets speed 0 (= full speed)");
+        assert!(goals[3].is_none());
+        // 1000 steps at 1706 steps/s plus one ramp.
+        assert!((500_000..1_500_000).contains(&duration), "{duration}");
+    }
+
+    #[test]
+    fn lower_speed_percent_is_slower() {
+        let cfg = AtomConfig::default();
+        let present = [Steps(2048); JOINTS];
+        let target = [Some(Steps(3048)); JOINTS];
+        let (_, fast) = plan_joint_move(&cfg, &present, &target, 100);
+        let (_, slow) = plan_joint_move(&cfg, &present, &target, 10);
+        assert!(slow > 3 * fast, "{slow} vs {fast}");
+    }
+}

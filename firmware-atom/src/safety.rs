@@ -1,0 +1,163 @@
+//! The one choke point every servo goal passes: joint limits, gripper range and power state.
+//!
+//! [`SafeGoals`] can only be made by [`check`], and the Atom sends position goals to servos
+//! only from a `SafeGoals` (`Atom::send_goals`): no command path (move, jog, linear
+//! interpolation, encoder write, raw servo data write) can put an unchecked goal on the bus.
+
+use protocol_core::servo::{SyncWriteBuilder, reg, to_sign_magnitude};
+use protocol_core::units::{Centideg, Steps};
+
+use crate::config::{AtomConfig, GRIPPER, JOINTS, JointLimit, SERVOS};
+
+/// A goal for one servo: where to go and how (the STS move block).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Goal {
+    /// Goal position.
+    pub position: Steps,
+    /// Goal speed, steps per second (at least 1: 0 means "as fast as possible" to the servo).
+    pub speed_steps_per_s: u16,
+    /// Acceleration register, 100 steps/s^2 units (at least 1: 0 means "no ramp").
+    pub accel: u8,
+}
+
+impl Goal {
+    /// The 7-byte move block at [`reg::MOVE_BLOCK`]: acceleration, goal position, goal time 0,
+    /// goal speed (little-endian sign-magnitude).
+    pub fn move_block(&self) -> [u8; reg::MOVE_BLOCK_LEN as usize] {
+        let [p0, p1] = to_sign_magnitude(self.position.0, 15).to_le_bytes();
+        let speed = self.speed_steps_per_s.clamp(1, i16::MAX as u16) as i16;
+        let [s0, s1] = to_sign_magnitude(speed, 15).to_le_bytes();
+        [self.accel.max(1), p0, p1, 0, 0, s0, s1]
+    }
+}
+
+/// Goals per servo (index 0..5 joints, 6 gripper), `None` = leave that servo alone.
+pub type GoalSet = [Option<Goal>; SERVOS];
+
+/// Why a set of goals was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Refusal {
+    /// The arm is powered off.
+    PoweredOff,
+    /// Joint `index` (0-based) would leave its limits.
+    JointLimit(usize),
+    /// The gripper goal is outside its calibrated range.
+    GripperRange,
+}
+
+/// Goals that passed [`check`]. The only input of the goal-sending path.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SafeGoals(GoalSet);
+
+impl SafeGoals {
+    /// The checked goals.
+    pub fn goals(&self) -> &GoalSet {
+        &self.0
+    }
+
+    /// The SYNC WRITE of the move blocks to the servos with a goal (`ids` per index).
+    pub fn sync_write(&self, ids: &[u8; SERVOS]) -> Option<protocol_core::servo::Packet> {
+        let mut b = SyncWriteBuilder::new(reg::MOVE_BLOCK, reg::MOVE_BLOCK_LEN);
+        for (goal, &id) in self.0.iter().zip(ids) {
+            if let Some(g) = goal {
+                b.push(id, &g.move_block())?;
+            }
+        }
+        b.to_packet()
+    }
+}
+
+/// Checks `goals` against the power state, `limits` and the gripper range of `config`.
+/// All or nothing: one bad goal refuses the whole set.
+pub fn check(
+    config: &AtomConfig,
+    limits: &[JointLimit; JOINTS],
+    powered: bool,
+    goals: GoalSet,
+) -> Result<SafeGoals, Refusal> {
+    if !powered {
+        return Err(Refusal::PoweredOff);
+    }
+    for (j, (goal, limit)) in goals.iter().zip(limits).enumerate() {
+        if let Some(g) = goal
+            && !goal_within(config, j, g.position, limit)
+        {
+            return Err(Refusal::JointLimit(j));
+        }
+    }
+    if let Some(Some(g)) = goals.get(GRIPPER) {
+        let (a, b) = (config.gripper.closed.0, config.gripper.open.0);
+        if !(a.min(b)..=a.max(b)).contains(&g.position.0) {
+            return Err(Refusal::GripperRange);
+        }
+    }
+    Ok(SafeGoals(goals))
+}
+
+/// True if encoder goal `position` of joint `joint` lies within `limit`. Compared in steps
+/// with the limit rounded inwards, so a goal that rounds to an angle just outside is refused.
+fn goal_within(config: &AtomConfig, joint: usize, position: Steps, limit: &JointLimit) -> bool {
+    let angle = config.steps_to_angle(joint, position);
+    let back = config.angle_to_steps(joint, angle);
+    back == position && limit.contains(angle) && in_turn(angle)
+}
+
+fn in_turn(angle: Centideg) -> bool {
+    (-18_000..=18_000).contains(&angle.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn goal_at(cfg: &AtomConfig, joint: usize, centideg: i16) -> Goal {
+        Goal {
+            position: cfg.angle_to_steps(joint, Centideg(centideg)),
+            speed_steps_per_s: 100,
+            accel: 10,
+        }
+    }
+
+    #[test]
+    fn refuses_out_of_limit_and_powered_off() {
+        let cfg = AtomConfig::default();
+        let limits = cfg.joint_limits;
+        let mut goals: GoalSet = [None; SERVOS];
+        goals[1] = Some(goal_at(&cfg, 1, 14_500)); // J2 limit is 140 deg
+        assert_eq!(
+            check(&cfg, &limits, true, goals),
+            Err(Refusal::JointLimit(1))
+        );
+        goals[1] = Some(goal_at(&cfg, 1, 13_900));
+        assert!(check(&cfg, &limits, true, goals).is_ok());
+        assert_eq!(
+            check(&cfg, &limits, false, goals),
+            Err(Refusal::PoweredOff)
+        );
+    }
+
+    #[test]
+    fn gripper_goal_must_stay_in_range() {
+        let cfg = AtomConfig::default();
+        let mut goals: GoalSet = [None; SERVOS];
+        goals[GRIPPER] = Some(Goal {
+            position: Steps(100),
+            speed_steps_per_s: 100,
+            accel: 10,
+        });
+        assert_eq!(
+            check(&cfg, &cfg.joint_limits, true, goals),
+            Err(Refusal::GripperRange)
+        );
+    }
+
+    #[test]
+    fn move_block_layout() {
+        let g = Goal {
+            position: Steps(3000),
+            speed_steps_per_s: 500,
+            accel: 0,
+        };
+        assert_eq!(g.move_block(), [1, 0xB8, 0x0B, 0, 0, 0xF4, 0x01]);
+    }
+}
