@@ -1,5 +1,6 @@
 //! The two protocols that travel on a myCobot 280 M5's wires, typed and zero-allocation.
 //!
+//! * [`command`]: what each host frame means: typed requests and replies, error codes.
 //! * [`frame`]: host frames `FE FE LEN CMD DATA FA` and a streaming decoder that finds them in
 //!   any byte stream (any chunking, garbage, servo packets on the same wire).
 //! * [`servo`]: Feetech STS servo packets `FF FF ID LEN ...`, their checksum, register values
@@ -12,6 +13,7 @@
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 
+pub mod command;
 pub mod frame;
 pub mod port;
 pub mod servo;
