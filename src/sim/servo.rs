@@ -534,3 +534,453 @@ impl Default for SimServo {
         Self::new(1, 2048)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::wire::{Bus, BusByte, StationId};
+    use protocol_core::servo::{SyncWriteBuilder, sign_magnitude};
+    use protocol_core::timing::SERVO_TURNAROUND_MAX_US;
+
+    /// A controller and some servos on one bus, stepped at every byte end and servo event.
+    struct Rig {
+        bus: Bus,
+        now_ns: u64,
+        controller: StationId,
+        servos: Vec<(StationId, SimServo)>,
+    }
+
+    impl Rig {
+        fn new(ids: &[u8]) -> Self {
+            let mut bus = Bus::mycobot(3);
+            bus.set_tracing(true);
+            let controller = bus.attach(false);
+            let servos = ids
+                .iter()
+                .map(|&id| (bus.attach(false), SimServo::new(id, 2048)))
+                .collect();
+            Self {
+                bus,
+                now_ns: 0,
+                controller,
+                servos,
+            }
+        }
+
+        fn servo(&mut self, i: usize) -> &mut SimServo {
+            &mut self.servos[i].1
+        }
+
+        fn run_until(&mut self, t_ns: u64) {
+            while self.now_ns < t_ns {
+                let next = self
+                    .servos
+                    .iter()
+                    .filter_map(|(_, s)| s.next_event_ns())
+                    .chain(self.bus.next_event_ns())
+                    .chain([t_ns, self.now_ns + CONTROL_PERIOD_NS])
+                    .min()
+                    .unwrap()
+                    .max(self.now_ns + 1);
+                self.now_ns = next;
+                self.bus.deliver(next);
+                for (station, servo) in &mut self.servos {
+                    servo.poll(next, &mut self.bus.port(*station).unwrap());
+                }
+                self.bus.start_transmissions(next);
+            }
+        }
+
+        fn run_for_ms(&mut self, ms: u64) {
+            self.run_until(self.now_ns + ms * 1_000_000);
+        }
+
+        /// Sends `packet`, runs 2 ms, returns the trace since the send.
+        fn exchange(&mut self, packet: &Packet) -> Vec<BusByte> {
+            self.exchange_bytes(&packet.to_bytes())
+        }
+
+        fn exchange_bytes(&mut self, bytes: &[u8]) -> Vec<BusByte> {
+            self.bus.take_trace();
+            self.bus.port(self.controller).unwrap().write(bytes);
+            self.bus.start_transmissions(self.now_ns);
+            self.run_for_ms(2);
+            self.bus.take_trace()
+        }
+
+        /// The servo packets in `trace` sent by anyone but the controller, decoded.
+        fn answers(&self, trace: &[BusByte]) -> Vec<Packet> {
+            let mut decoder = PacketDecoder::new();
+            let mut out = Vec::new();
+            let bytes: Vec<u8> = trace
+                .iter()
+                .filter(|b| b.from != self.controller)
+                .map(|b| b.byte)
+                .collect();
+            decoder.feed(&bytes, |p| out.push(p));
+            out
+        }
+
+        fn read(&mut self, id: u8, addr: u8, count: u8) -> Option<Packet> {
+            let trace = self.exchange(&Instruction::Read { addr, count }.to_packet(id).unwrap());
+            self.answers(&trace).into_iter().next()
+        }
+
+        fn write(&mut self, id: u8, addr: u8, data: &[u8]) -> Vec<Packet> {
+            let trace = self.exchange(&Instruction::Write { addr, data }.to_packet(id).unwrap());
+            self.answers(&trace)
+        }
+    }
+
+    fn move_block(accel: u8, goal: u16, speed: u16) -> Vec<u8> {
+        let mut block = vec![accel];
+        block.extend_from_slice(&goal.to_le_bytes());
+        block.extend_from_slice(&[0, 0]);
+        block.extend_from_slice(&speed.to_le_bytes());
+        block
+    }
+
+    #[test]
+    fn ping_is_answered_within_the_turnaround_budget() {
+        let mut rig = Rig::new(&[1]);
+        let trace = rig.exchange(&Instruction::Ping.to_packet(1).unwrap());
+        let request_end = trace
+            .iter()
+            .filter(|b| b.from == rig.controller)
+            .last()
+            .unwrap()
+            .end_ns;
+        let answer_start = trace
+            .iter()
+            .find(|b| b.from != rig.controller)
+            .unwrap()
+            .start_ns;
+        let turnaround = answer_start - request_end;
+        assert!(turnaround > 0 && turnaround <= SERVO_TURNAROUND_MAX_US * 1_000);
+        let answers = rig.answers(&trace);
+        assert_eq!(answers.len(), 1);
+        assert_eq!((answers[0].id(), answers[0].code()), (1, 0));
+        assert!(answers[0].params().is_empty());
+    }
+
+    #[test]
+    fn return_delay_register_lengthens_the_turnaround() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::RETURN_DELAY, &[50]);
+        assert_eq!(rig.servo(0).reg(reg::RETURN_DELAY), 0, "EEPROM is locked");
+        rig.write(1, reg::EEPROM_LOCK, &[0]);
+        rig.write(1, reg::RETURN_DELAY, &[50]);
+        let trace = rig.exchange(&Instruction::Ping.to_packet(1).unwrap());
+        let request_end = trace
+            .iter()
+            .filter(|b| b.from == rig.controller)
+            .last()
+            .unwrap()
+            .end_ns;
+        let answer_start = trace
+            .iter()
+            .find(|b| b.from != rig.controller)
+            .unwrap()
+            .start_ns;
+        assert_eq!(answer_start - request_end, 100_000 + PROCESSING_NS);
+    }
+
+    #[test]
+    fn factory_table_reads_back() {
+        let mut rig = Rig::new(&[4]);
+        let eeprom = rig.read(4, 0, 40).unwrap();
+        let p = eeprom.params();
+        assert_eq!(p.len(), 40);
+        assert_eq!(u16::from_le_bytes([p[3], p[4]]), MODEL_STS3215);
+        assert_eq!(p[usize::from(reg::ID)], 4);
+        assert_eq!(p[usize::from(reg::BAUD_RATE)], 0);
+        assert_eq!(u16::from_le_bytes([p[11], p[12]]), 4095);
+        assert_eq!(
+            &p[21..24],
+            &[32, 32, 0],
+            "joint 4 has the vendor's stiffer PID"
+        );
+        let mut other = Rig::new(&[2]);
+        assert_eq!(
+            &other.read(2, reg::P_COEFFICIENT, 3).unwrap().params(),
+            &[10, 0, 1]
+        );
+        let state = rig.read(4, reg::STATE_BLOCK, reg::STATE_BLOCK_LEN).unwrap();
+        assert_eq!(state.u16_at(0), Some(2048));
+        assert_eq!(state.params()[6], SUPPLY_DECIVOLT);
+        assert_eq!(state.params()[7], AMBIENT_C);
+        assert_eq!(state.params()[10], 0, "not moving");
+    }
+
+    #[test]
+    fn goal_with_speed_and_acceleration_moves_along_a_trapezoid() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        // 1000 steps at 1000 steps/s with 5000 steps/s^2: 0.2 s ramps, 1.2 s in total.
+        let acks = rig.write(1, reg::MOVE_BLOCK, &move_block(50, 3048, 1000));
+        assert_eq!(acks.len(), 1, "status return level 1 acknowledges writes");
+        rig.run_for_ms(100);
+        let early = rig.servo(0).present_position();
+        assert!(
+            (2048 + 15..2048 + 35).contains(&early),
+            "accelerating: {early}"
+        );
+        rig.run_for_ms(400);
+        let state = rig.read(1, reg::STATE_BLOCK, reg::STATE_BLOCK_LEN).unwrap();
+        let speed = sign_magnitude(state.u16_at(2).unwrap(), 15);
+        assert!(
+            (990..=1000).contains(&speed),
+            "cruising at the goal speed: {speed}"
+        );
+        assert_eq!(state.params()[10], 1, "moving flag");
+        assert!(
+            sign_magnitude(state.u16_at(4).unwrap(), 10) > 0,
+            "load while moving"
+        );
+        rig.run_for_ms(600);
+        assert!(rig.servo(0).is_moving());
+        assert!(rig.servo(0).present_position() < 3048);
+        rig.run_for_ms(150);
+        assert_eq!(rig.servo(0).present_position(), 3048);
+        assert!(!rig.servo(0).is_moving());
+        let state = rig.read(1, reg::STATE_BLOCK, reg::STATE_BLOCK_LEN).unwrap();
+        assert_eq!(state.u16_at(2), Some(0));
+    }
+
+    #[test]
+    fn moves_backwards_too_and_respects_position_limits() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        rig.write(1, reg::EEPROM_LOCK, &[0]);
+        rig.write(1, reg::MIN_POSITION, &1500u16.to_le_bytes());
+        rig.write(1, reg::EEPROM_LOCK, &[1]);
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 100, 0));
+        assert_eq!(rig.servo(0).goal_position(), 1500);
+        rig.run_for_ms(400);
+        assert_eq!(rig.servo(0).present_position(), 1500);
+    }
+
+    #[test]
+    fn torque_off_holds_nothing_and_hand_moves_stick() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 3000, 0));
+        rig.run_for_ms(300);
+        assert_eq!(
+            rig.servo(0).present_position(),
+            2048,
+            "torque is off at power-up"
+        );
+        rig.servo(0).move_by_hand(1000);
+        rig.run_for_ms(10);
+        assert_eq!(
+            rig.read(1, reg::PRESENT_POSITION, 2).unwrap().u16_at(0),
+            Some(1000)
+        );
+        // Enabling torque holds the arm where the hand left it.
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        rig.run_for_ms(100);
+        assert_eq!(rig.servo(0).present_position(), 1000);
+    }
+
+    #[test]
+    fn torque_128_makes_the_present_position_2048_without_moving() {
+        let mut rig = Rig::new(&[1]);
+        rig.servo(0).move_by_hand(2500);
+        rig.write(1, reg::TORQUE_ENABLE, &[128]);
+        assert_eq!(
+            rig.read(1, reg::PRESENT_POSITION, 2).unwrap().u16_at(0),
+            Some(2048)
+        );
+        let offset = rig
+            .read(1, reg::HOMING_OFFSET, 2)
+            .unwrap()
+            .u16_at(0)
+            .unwrap();
+        assert_eq!(sign_magnitude(offset, 11), 452);
+        // Goals are in the calibrated frame: 2148 is 100 steps past the new zero.
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 2148, 0));
+        rig.run_for_ms(200);
+        assert_eq!(rig.servo(0).present_position(), 2148);
+    }
+
+    #[test]
+    fn eeprom_lock_protects_the_id() {
+        let mut rig = Rig::new(&[3]);
+        rig.write(3, reg::ID, &[9]);
+        assert_eq!(rig.servo(0).id(), 3);
+        rig.write(3, reg::EEPROM_LOCK, &[0]);
+        rig.write(3, reg::ID, &[9]);
+        assert_eq!(rig.servo(0).id(), 9);
+        assert!(rig.read(3, reg::ID, 1).is_none());
+        assert_eq!(rig.read(9, reg::ID, 1).unwrap().params(), &[9]);
+    }
+
+    #[test]
+    fn read_only_registers_ignore_writes() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::EEPROM_LOCK, &[0]);
+        rig.write(1, reg::MODEL, &[1, 2]);
+        rig.write(1, reg::PRESENT_POSITION, &[0, 0]);
+        assert_eq!(rig.servo(0).reg_u16(reg::MODEL), MODEL_STS3215);
+        assert_eq!(rig.servo(0).present_position(), 2048);
+    }
+
+    #[test]
+    fn broadcast_and_status_return_level_silence_replies() {
+        let mut rig = Rig::new(&[1, 2]);
+        assert!(rig.write(BROADCAST_ID, reg::TORQUE_ENABLE, &[1]).is_empty());
+        assert!(rig.servo(0).torque_enabled() && rig.servo(1).torque_enabled());
+        rig.write(1, reg::EEPROM_LOCK, &[0]);
+        rig.write(1, reg::STATUS_RETURN_LEVEL, &[0]);
+        assert_eq!(rig.servo(0).reg(reg::STATUS_RETURN_LEVEL), 0);
+        assert!(
+            rig.write(1, reg::GOAL_POSITION, &2100u16.to_le_bytes())
+                .is_empty()
+        );
+        assert!(
+            rig.read(1, reg::GOAL_POSITION, 2).is_some(),
+            "READ still answers"
+        );
+        assert_eq!(
+            rig.write(2, reg::GOAL_POSITION, &2100u16.to_le_bytes())
+                .len(),
+            1
+        );
+    }
+
+    #[test]
+    fn sync_write_moves_each_servo_to_its_own_goal_without_replies() {
+        let mut rig = Rig::new(&[1, 2, 3]);
+        rig.write(BROADCAST_ID, reg::TORQUE_ENABLE, &[1]);
+        let mut sync = SyncWriteBuilder::new(reg::MOVE_BLOCK, reg::MOVE_BLOCK_LEN);
+        for (id, goal) in [(1, 1000), (3, 3000)] {
+            sync.push(id, &move_block(0, goal, 0)).unwrap();
+        }
+        let trace = rig.exchange(&sync.to_packet().unwrap());
+        assert!(rig.answers(&trace).is_empty());
+        rig.run_for_ms(500);
+        let positions: Vec<u16> = (0..3).map(|i| rig.servo(i).present_position()).collect();
+        assert_eq!(positions, vec![1000, 2048, 3000]);
+    }
+
+    #[test]
+    fn sync_read_answers_in_order_without_colliding() {
+        let mut rig = Rig::new(&[1, 2, 3]);
+        rig.servo(1).move_by_hand(1111);
+        let ids = [3, 1, 2];
+        let packet = Instruction::SyncRead {
+            addr: reg::STATE_BLOCK,
+            count: reg::STATE_BLOCK_LEN,
+            ids: &ids,
+        }
+        .to_packet(BROADCAST_ID)
+        .unwrap();
+        let trace = rig.exchange(&packet);
+        assert_eq!(rig.bus.collisions(), 0);
+        let answers = rig.answers(&trace);
+        let got: Vec<(u8, Option<u16>)> = answers.iter().map(|p| (p.id(), p.u16_at(0))).collect();
+        assert_eq!(got, vec![(3, Some(2048)), (1, Some(2048)), (2, Some(1111))]);
+    }
+
+    #[test]
+    fn reg_write_waits_for_action() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        let block = move_block(0, 2500, 0);
+        let held = Instruction::RegWrite {
+            addr: reg::MOVE_BLOCK,
+            data: &block,
+        };
+        rig.exchange(&held.to_packet(1).unwrap());
+        rig.run_for_ms(100);
+        assert_eq!(rig.servo(0).present_position(), 2048);
+        rig.exchange(&Instruction::Action.to_packet(BROADCAST_ID).unwrap());
+        rig.run_for_ms(300);
+        assert_eq!(rig.servo(0).present_position(), 2500);
+        assert_eq!(rig.servo(0).stats().goal_writes, 1);
+    }
+
+    #[test]
+    fn silent_servo_does_not_answer_but_the_others_do() {
+        let mut rig = Rig::new(&[1, 2]);
+        rig.servo(0).set_faults(Faults {
+            no_answer: true,
+            ..Faults::default()
+        });
+        assert!(rig.read(1, reg::PRESENT_POSITION, 2).is_none());
+        assert!(rig.read(2, reg::PRESENT_POSITION, 2).is_some());
+        rig.servo(0).set_faults(Faults::default());
+        assert!(rig.read(1, reg::PRESENT_POSITION, 2).is_some(), "recovers");
+    }
+
+    #[test]
+    fn bad_checksum_fault_corrupts_every_answer() {
+        let mut rig = Rig::new(&[1]);
+        rig.servo(0).set_faults(Faults {
+            bad_checksum: true,
+            ..Faults::default()
+        });
+        let trace = rig.exchange(&Instruction::Ping.to_packet(1).unwrap());
+        assert!(
+            trace.iter().any(|b| b.from != rig.controller),
+            "it does send"
+        );
+        assert!(rig.answers(&trace).is_empty(), "but nothing decodes");
+    }
+
+    #[test]
+    fn stalled_servo_never_arrives_and_reports_overload() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        rig.servo(0).set_faults(Faults {
+            stall: true,
+            ..Faults::default()
+        });
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 3000, 0));
+        rig.run_for_ms(1000);
+        let state = rig.read(1, reg::STATE_BLOCK, reg::STATE_BLOCK_LEN).unwrap();
+        assert_eq!(state.u16_at(0), Some(2048));
+        assert_eq!(state.code() & fault::OVERLOAD, fault::OVERLOAD, "ERR byte");
+        assert!(
+            sign_magnitude(state.u16_at(4).unwrap(), 10) > 900,
+            "load near max"
+        );
+        assert_eq!(
+            state.params()[9] & fault::OVERLOAD,
+            fault::OVERLOAD,
+            "status register"
+        );
+        assert_eq!(state.params()[10], 1, "still trying to move");
+    }
+
+    #[test]
+    fn overheated_servo_reports_temperature_and_fault_bit() {
+        let mut rig = Rig::new(&[1]);
+        rig.servo(0).set_faults(Faults {
+            overheat: true,
+            ..Faults::default()
+        });
+        let state = rig.read(1, reg::STATE_BLOCK, reg::STATE_BLOCK_LEN).unwrap();
+        assert_eq!(state.code(), fault::OVERHEAT);
+        assert_eq!(state.params()[7], OVERHEAT_C);
+    }
+
+    #[test]
+    fn noise_before_a_packet_does_not_hide_it() {
+        let mut rig = Rig::new(&[1]);
+        // The start of a long packet that never finishes, then silence.
+        rig.bus
+            .port(rig.controller)
+            .unwrap()
+            .write(&[0xFF, 0xFF, 0x01, 0x40, 0x13]);
+        rig.bus.start_transmissions(rig.now_ns);
+        rig.run_for_ms(1);
+        assert!(rig.read(1, reg::ID, 1).is_some());
+        // A stray FF right before a packet is skipped too.
+        let mut bytes = vec![0xFF];
+        bytes.extend_from_slice(&Instruction::Ping.to_packet(1).unwrap().to_bytes());
+        let trace = rig.exchange_bytes(&bytes);
+        assert_eq!(rig.answers(&trace).len(), 1);
+    }
+}
