@@ -1,3 +1,220 @@
-//! Fixed-point kinematics of the myCobot 280 M5 (`kinematics.md`).
+//! Fixed-point kinematics of the myCobot 280 M5 (`kinematics.md`): forward and closed-form
+//! inverse kinematics of the flange for the vendor DH table, tool and world frames, joint
+//! limits as data, and straight-line Cartesian paths.
+//!
+//! Everything is integer arithmetic (no floating point, no allocation, no panics), so it runs
+//! the same on the host and on a core without an FPU. Inputs and outputs use the protocol's
+//! units: joint angles and orientations in centidegrees, positions in tenths of a millimetre.
+//! Internally lengths are 1/16 um and ratios Q30 (see [`fixed`] and [`transform`]).
+//!
+//! ```
+//! use kinematics_core::{JointAngles, Kinematics};
+//! let kin = Kinematics::new();
+//! let pose = kin.forward(&JointAngles([0; 6]));
+//! assert_eq!((pose.x, pose.y, pose.z), (456, -634, 4127)); // 45.6, -63.4, 412.7 mm
+//! let q = kin.inverse(&pose, &JointAngles([0; 6])).unwrap();
+//! assert!(q.0.iter().all(|a| a.abs() <= 2));
+//! ```
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
+
+pub mod fixed;
+pub mod geometry;
+mod ik;
+pub mod limits;
+pub mod path;
+pub mod transform;
+
+pub use geometry::ArmGeometry;
+pub use limits::JointLimits;
+pub use path::{LinearPath, PathError};
+pub use transform::{Rotation, Transform};
+
+use fixed::Angle;
+use geometry::Links;
+
+/// Joint angles q (protocol angles, not DH theta), centidegrees, joints 1..6.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct JointAngles(pub [i32; 6]);
+
+/// A pose: x, y, z in tenths of a millimetre; rx, ry, rz in centidegrees,
+/// R = Rz(rz) * Ry(ry) * Rx(rx).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Pose {
+    /// x, 0.1 mm.
+    pub x: i32,
+    /// y, 0.1 mm.
+    pub y: i32,
+    /// z, 0.1 mm.
+    pub z: i32,
+    /// Roll about the fixed x axis, 0.01 deg.
+    pub rx: i32,
+    /// Pitch about the fixed y axis, 0.01 deg.
+    pub ry: i32,
+    /// Yaw about the fixed z axis, 0.01 deg.
+    pub rz: i32,
+}
+
+/// Why a pose has no joint solution (protocol error 32, see [`IkError::PROTOCOL_CODE`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IkError {
+    /// The pose is out of the arm's reach (too far, or too close to the J1 axis).
+    Unreachable,
+    /// The pose is reachable, but every branch puts some joint outside its limits.
+    OutsideLimits,
+    /// The geometry degenerates (the two-link chain folds onto the J2 axis) so the joints are
+    /// not determined; impossible with the vendor link lengths, kept for calibrated ones.
+    Singular,
+}
+
+impl IkError {
+    /// The 0x07 error code for "IK has no solution".
+    pub const PROTOCOL_CODE: u8 = 32;
+}
+
+/// The robot model: link geometry, joint limits, and the tool and world frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Kinematics {
+    links: Links,
+    limits: JointLimits,
+    /// Tool pose in the flange frame, and its inverse.
+    tool: Option<(Transform, Transform)>,
+    /// Base pose in the world frame, and its inverse.
+    world: Option<(Transform, Transform)>,
+}
+
+impl Default for Kinematics {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Kinematics {
+    /// Vendor DH table, default limits, identity frames.
+    pub fn new() -> Self {
+        Self::with_geometry(&ArmGeometry::MYCOBOT_280)
+    }
+
+    /// A model with a calibrated geometry, default limits, identity frames.
+    pub fn with_geometry(geometry: &ArmGeometry) -> Self {
+        Self {
+            links: Links::new(geometry),
+            limits: JointLimits::default(),
+            tool: None,
+            world: None,
+        }
+    }
+
+    /// The joint limits every solution respects.
+    pub fn limits(&self) -> &JointLimits {
+        &self.limits
+    }
+
+    /// Replaces the joint limits (protocol 0x4C / 0x4D).
+    pub fn set_limits(&mut self, limits: JointLimits) {
+        self.limits = limits;
+    }
+
+    /// Sets the tool pose in the flange frame (end type TOOL), or `None` for the flange itself.
+    pub fn set_tool(&mut self, tool: Option<Pose>) {
+        self.tool = tool.map(|p| with_inverse(Transform::from_pose(&p)));
+    }
+
+    /// Sets the base pose in the world frame (reference frame WORLD), or `None` for the base.
+    pub fn set_world(&mut self, world: Option<Pose>) {
+        self.world = world.map(|p| with_inverse(Transform::from_pose(&p)));
+    }
+
+    /// The end pose (tool in world, per the selected frames) at joint angles `q`.
+    pub fn forward(&self, q: &JointAngles) -> Pose {
+        self.forward_transform(q).to_pose()
+    }
+
+    /// The end pose as a full-precision transform (1/16 um, Q30 rotation).
+    pub fn forward_transform(&self, q: &JointAngles) -> Transform {
+        let mut t = self.links.flange(q);
+        if let Some((world, _)) = &self.world {
+            t = world.then(&t);
+        }
+        if let Some((tool, _)) = &self.tool {
+            t = t.then(tool);
+        }
+        t
+    }
+
+    /// The joint angles that put the end (per the selected frames) at `target`: of all branches
+    /// within the limits (each joint wrapped by +-360 deg), the one nearest `seed`.
+    pub fn inverse(&self, target: &Pose, seed: &JointAngles) -> Result<JointAngles, IkError> {
+        self.inverse_transform(&Transform::from_pose(target), seed)
+    }
+
+    /// [`Kinematics::inverse`] for a full-precision target transform.
+    pub fn inverse_transform(
+        &self,
+        target: &Transform,
+        seed: &JointAngles,
+    ) -> Result<JointAngles, IkError> {
+        let mut flange = *target;
+        if let Some((_, world_inv)) = &self.world {
+            flange = world_inv.then(&flange);
+        }
+        if let Some((_, tool_inv)) = &self.tool {
+            flange = flange.then(tool_inv);
+        }
+        let seed_theta6 = self.links.theta(5, seed.0[5]);
+        let branches = ik::solve(&self.links, &flange, seed_theta6)?;
+        branches
+            .iter()
+            .flatten()
+            .filter_map(|theta| self.in_limits_near(theta, seed))
+            .min_by_key(|(_, distance)| *distance)
+            .map(|(q, _)| q)
+            .ok_or(IkError::OutsideLimits)
+    }
+
+    /// Every branch for `target` as joint angles wrapped into the limits near `seed` (`None` for
+    /// a branch that does not exist or does not fit the limits), indexed
+    /// shoulder * 4 + wrist * 2 + elbow.
+    pub fn inverse_all(
+        &self,
+        target: &Pose,
+        seed: &JointAngles,
+    ) -> Result<[Option<JointAngles>; 8], IkError> {
+        let mut flange = Transform::from_pose(target);
+        if let Some((_, world_inv)) = &self.world {
+            flange = world_inv.then(&flange);
+        }
+        if let Some((_, tool_inv)) = &self.tool {
+            flange = flange.then(tool_inv);
+        }
+        let branches = ik::solve(&self.links, &flange, self.links.theta(5, seed.0[5]))?;
+        Ok(branches.map(|b| {
+            b.and_then(|theta| self.in_limits_near(&theta, seed))
+                .map(|(q, _)| q)
+        }))
+    }
+
+    /// DH angles `theta` as protocol angles wrapped into the limits nearest `seed`, with the
+    /// squared distance to the seed; `None` if some joint cannot fit.
+    fn in_limits_near(&self, theta: &[Angle; 6], seed: &JointAngles) -> Option<(JointAngles, i64)> {
+        let mut q = [0i32; 6];
+        let mut distance = 0i64;
+        for (i, ((slot, &t), &s)) in q
+            .iter_mut()
+            .zip(theta.iter())
+            .zip(seed.0.iter())
+            .enumerate()
+        {
+            let offset = self.links.offset.get(i).copied().unwrap_or(Angle::ZERO);
+            *slot = self.limits.wrap_into(i, t.sub(offset).to_centideg(), s)?;
+            let d = i64::from(*slot) - i64::from(s);
+            distance += d * d;
+        }
+        Some((JointAngles(q), distance))
+    }
+}
+
+/// A transform paired with its inverse.
+fn with_inverse(t: Transform) -> (Transform, Transform) {
+    (t, t.inverse())
+}
