@@ -1,0 +1,348 @@
+//! The bus side of the transponder: sends one request at a time onto the shared wire and
+//! returns the one reply that answers it.
+//!
+//! A request is transmitted only into a quiet wire ([`timing::BUS_QUIET_BEFORE_SEND_US`]),
+//! its echo is read back and compared when the wiring echoes, a collision (echo differs, or a
+//! foreign byte while transmitting) is retransmitted after a growing back-off, at most
+//! [`BasicConfig::max_send_attempts`] times. Then only a complete `FE FE` frame with the
+//! request's CMD byte counts as the reply; servo packets, other frames and late duplicates are
+//! dropped, and a request that gets no reply is given up after its deadline so the next one can
+//! go. Requests wait in a bounded queue meanwhile.
+
+use heapless::{Deque, Vec};
+use protocol_core::frame::MAX_FRAME_BYTES;
+use protocol_core::{BytePort, Frame, FrameDecoder, timing};
+
+use crate::config::{BasicConfig, EchoMode};
+
+/// Requests that may wait behind the one in flight. pymycobot sends one request at a time
+/// and waits for its reply; 8 absorbs clients that pipeline a few without letting a flood
+/// queue seconds of stale commands.
+pub const REQUEST_QUEUE_DEPTH: usize = 8;
+/// How long after the transmitter went idle the rest of an echo may still arrive (receiver
+/// latency of the board), in microseconds: two byte times at 1 Mbaud, shorter than any Atom
+/// turnaround so the reply is not mistaken for a broken echo.
+pub const ECHO_GRACE_US: u64 = 20;
+/// Longest back-off after a collision, in microseconds.
+pub const MAX_BACKOFF_US: u64 = 2_000;
+
+/// Who asked for a request, and so where its reply goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Origin {
+    /// The host: the reply goes to the host.
+    Host,
+    /// The Basic's boot power-on (0x10): the reply is consumed.
+    PowerOn,
+    /// The Basic's liveness probe (0x12): the reply is consumed.
+    Probe,
+}
+
+/// A request to the Atom.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Request {
+    pub(crate) frame: Frame,
+    pub(crate) origin: Origin,
+}
+
+/// What happened to a request, for the caller to act on.
+#[derive(Debug, PartialEq, Eq)]
+pub(crate) enum Event {
+    /// `reply` answers `request`.
+    Reply { request: Request, reply: Frame },
+    /// The Atom did not answer `request` in time.
+    Timeout(Request),
+    /// `request` collided on every attempt and was given up.
+    GaveUp(Request),
+    /// A transmission collided and will be repeated.
+    Collision,
+    /// A frame from the bus answered nothing outstanding and was dropped.
+    Unsolicited,
+}
+
+#[derive(Debug)]
+enum Stage {
+    /// Waiting for the wire to be quiet (and any back-off to pass).
+    WaitQuiet { not_before_us: u64 },
+    /// On the wire; `echoed` bytes of it have come back so far.
+    Transmitting {
+        echoed: usize,
+        collided: bool,
+        tx_done_us: Option<u64>,
+    },
+    /// Sent; waiting for the reply until `deadline_us`.
+    AwaitReply { deadline_us: u64 },
+}
+
+#[derive(Debug)]
+struct InFlight {
+    request: Request,
+    wire: Vec<u8, MAX_FRAME_BYTES>,
+    attempts: u8,
+    stage: Stage,
+}
+
+/// The bus forwarder.
+#[derive(Debug)]
+pub(crate) struct Forwarder {
+    queue: Deque<Request, REQUEST_QUEUE_DEPTH>,
+    current: Option<InFlight>,
+    decoder: FrameDecoder,
+    /// When the wire was last busy: a byte heard, or the end of our own transmission.
+    last_activity_us: u64,
+    last_rx_us: u64,
+    echo_heard: Option<bool>,
+}
+
+impl Forwarder {
+    pub(crate) const fn new() -> Self {
+        Self {
+            queue: Deque::new(),
+            current: None,
+            decoder: FrameDecoder::new(),
+            last_activity_us: 0,
+            last_rx_us: 0,
+            echo_heard: None,
+        }
+    }
+
+    /// Treats the wire as busy until `now_us` (at boot, its history is unknown).
+    pub(crate) fn note_activity(&mut self, now_us: u64) {
+        self.last_activity_us = self.last_activity_us.max(now_us);
+    }
+
+    /// Whether the echo has been heard (`Some(true)`), found missing, or not tried yet.
+    pub(crate) fn echo_heard(&self) -> Option<bool> {
+        self.echo_heard
+    }
+
+    /// True while a request is in flight or queued.
+    pub(crate) fn busy(&self) -> bool {
+        self.current.is_some() || !self.queue.is_empty()
+    }
+
+    /// Queues a request; gives it back if the queue is full.
+    pub(crate) fn enqueue(&mut self, request: Request) -> Result<(), Request> {
+        self.queue.push_back(request)
+    }
+
+    /// Drops every queued and in-flight request and any partial frame (mode change).
+    pub(crate) fn clear(&mut self) {
+        self.queue.clear();
+        self.current = None;
+        self.decoder = FrameDecoder::new();
+    }
+
+    /// Microseconds the wire has been quiet.
+    pub(crate) fn quiet_for_us(&self, now_us: u64) -> u64 {
+        now_us.saturating_sub(self.last_activity_us)
+    }
+
+    /// Handles one byte heard on the bus at `now_us`.
+    pub(crate) fn on_bus_byte(
+        &mut self,
+        now_us: u64,
+        byte: u8,
+        config: &BasicConfig,
+        mut on_event: impl FnMut(Event),
+    ) {
+        self.last_activity_us = now_us;
+        self.last_rx_us = now_us;
+        if let Some(InFlight {
+            wire,
+            stage: Stage::Transmitting {
+                echoed, collided, ..
+            },
+            ..
+        }) = &mut self.current
+        {
+            if !*collided {
+                if config.echo != EchoMode::Absent && wire.get(*echoed) == Some(&byte) {
+                    *echoed += 1;
+                    if *echoed == wire.len() {
+                        self.echo_heard = Some(true);
+                        self.start_waiting(now_us, config);
+                    }
+                    return;
+                }
+                *collided = true;
+            }
+        }
+        let mut frames: Vec<Frame, 2> = Vec::new();
+        self.decoder.feed(&[byte], |frame| {
+            // A byte completes at most one frame plus whatever its rescan uncovers; keep two.
+            let _ = frames.push(frame);
+        });
+        for frame in frames {
+            self.on_frame(frame, &mut on_event);
+        }
+    }
+
+    /// Checks deadlines and the transmitter; starts the next transmission when the wire
+    /// allows. Call after the bytes that arrived have been passed to [`Self::on_bus_byte`].
+    pub(crate) fn poll<B: BytePort>(
+        &mut self,
+        now_us: u64,
+        bus: &mut B,
+        config: &BasicConfig,
+        mut on_event: impl FnMut(Event),
+    ) {
+        if self.decoder.has_partial()
+            && now_us.saturating_sub(self.last_rx_us) >= timing::BUS_FRAME_GAP_US
+        {
+            let mut next = self.decoder.on_quiet_line();
+            while let Some(frame) = next {
+                self.on_frame(frame, &mut on_event);
+                next = self.decoder.next_frame();
+            }
+        }
+        self.check_transmission(now_us, bus, config, &mut on_event);
+        if let Some(InFlight {
+            stage: Stage::AwaitReply { deadline_us },
+            ..
+        }) = &self.current
+            && now_us >= *deadline_us
+            && let Some(done) = self.current.take()
+        {
+            on_event(Event::Timeout(done.request));
+        }
+        if self.current.is_none()
+            && let Some(request) = self.queue.pop_front()
+        {
+            let mut wire = Vec::new();
+            let mut buf = [0u8; MAX_FRAME_BYTES];
+            if let Some(bytes) = request.frame.encode(&mut buf).and_then(|n| buf.get(..n)) {
+                // Cannot fail: a frame's encoding fits MAX_FRAME_BYTES.
+                let _ = wire.extend_from_slice(bytes);
+            }
+            self.current = Some(InFlight {
+                request,
+                wire,
+                attempts: 0,
+                stage: Stage::WaitQuiet { not_before_us: 0 },
+            });
+        }
+        self.try_send(now_us, bus);
+    }
+
+    /// Follows a transmission to its end: echo complete, silent, or collided.
+    fn check_transmission<B: BytePort>(
+        &mut self,
+        now_us: u64,
+        bus: &mut B,
+        config: &BasicConfig,
+        on_event: &mut impl FnMut(Event),
+    ) {
+        let echo_required = match config.echo {
+            EchoMode::Present => true,
+            EchoMode::Absent => false,
+            EchoMode::Auto => self.echo_heard == Some(true),
+        };
+        let Some(InFlight {
+            stage:
+                Stage::Transmitting {
+                    echoed,
+                    collided,
+                    tx_done_us,
+                },
+            ..
+        }) = &mut self.current
+        else {
+            return;
+        };
+        if !bus.tx_idle() {
+            return;
+        }
+        let done_at = *tx_done_us.get_or_insert(now_us);
+        self.last_activity_us = self.last_activity_us.max(done_at);
+        let collided = *collided;
+        let silent = *echoed == 0;
+        let grace_over = now_us.saturating_sub(done_at) >= ECHO_GRACE_US;
+        // Until the echo is known either way, give a late echo its grace time: taken for the
+        // Atom's reply, our own request would be passed to the host as its answer.
+        let silence_is_final = config.echo == EchoMode::Absent || self.echo_heard.is_some();
+        if collided || (grace_over && (echo_required || !silent)) {
+            self.on_collision(now_us, config, on_event);
+        } else if silent && !echo_required && (silence_is_final || grace_over) {
+            if config.echo == EchoMode::Auto {
+                self.echo_heard = Some(false);
+            }
+            self.start_waiting(now_us, config);
+        }
+    }
+
+    fn on_collision(
+        &mut self,
+        now_us: u64,
+        config: &BasicConfig,
+        on_event: &mut impl FnMut(Event),
+    ) {
+        let Some(flight) = &mut self.current else {
+            return;
+        };
+        flight.attempts = flight.attempts.saturating_add(1);
+        if flight.attempts >= config.max_send_attempts.max(1) {
+            if let Some(done) = self.current.take() {
+                on_event(Event::GaveUp(done.request));
+            }
+            return;
+        }
+        on_event(Event::Collision);
+        // Back off a little longer each time, so a station that keeps talking gets its turn.
+        let backoff_us =
+            (timing::BUS_QUIET_BEFORE_SEND_US << flight.attempts.min(6)).min(MAX_BACKOFF_US);
+        flight.stage = Stage::WaitQuiet {
+            not_before_us: now_us.saturating_add(backoff_us),
+        };
+    }
+
+    fn start_waiting(&mut self, now_us: u64, config: &BasicConfig) {
+        if let Some(flight) = &mut self.current {
+            let timeout_us = match flight.request.origin {
+                Origin::Host => config.reply_timeout_us,
+                Origin::PowerOn | Origin::Probe => config.probe_timeout_us,
+            };
+            flight.stage = Stage::AwaitReply {
+                deadline_us: now_us.saturating_add(timeout_us),
+            };
+        }
+    }
+
+    /// Transmits the request in flight if the wire is free.
+    fn try_send<B: BytePort>(&mut self, now_us: u64, bus: &mut B) {
+        let quiet_us = self.quiet_for_us(now_us);
+        let Some(flight) = &mut self.current else {
+            return;
+        };
+        let Stage::WaitQuiet { not_before_us } = flight.stage else {
+            return;
+        };
+        if now_us < not_before_us || quiet_us < timing::BUS_QUIET_BEFORE_SEND_US || !bus.tx_idle() {
+            return;
+        }
+        // The wire is quiet: a partial frame in the decoder can no longer complete, and must not
+        // swallow the reply.
+        while self.decoder.on_quiet_line().is_some() {}
+        bus.write(&flight.wire);
+        flight.stage = Stage::Transmitting {
+            echoed: 0,
+            collided: false,
+            tx_done_us: None,
+        };
+    }
+
+    fn on_frame(&mut self, frame: Frame, on_event: &mut impl FnMut(Event)) {
+        let answers = matches!(
+            &self.current,
+            Some(InFlight { request, stage: Stage::AwaitReply { .. }, .. })
+                if request.frame.cmd() == frame.cmd()
+        );
+        if answers && let Some(done) = self.current.take() {
+            on_event(Event::Reply {
+                request: done.request,
+                reply: frame,
+            });
+        } else {
+            on_event(Event::Unsolicited);
+        }
+    }
+}

@@ -1,0 +1,110 @@
+//! The host side of the transponder: frames the host's byte stream (with the quiet-gap rule
+//! for truncated frames) and queues bytes for the host without ever blocking the loop.
+
+use heapless::Deque;
+use protocol_core::frame::MAX_FRAME_BYTES;
+use protocol_core::{BytePort, Frame, FrameDecoder, timing};
+
+/// Bytes waiting for the host link. Replies are written one at a time, so this only fills in
+/// transparent mode when the bus (1 Mbaud) outpaces the host link (115200): 512 bytes is
+/// 44 ms of host link time.
+pub const HOST_TX_CAPACITY: usize = 512;
+/// Most bytes handed to the host port in one write: well under the ESP32 UART's 128-byte FIFO,
+/// so a write into an idle transmitter never waits.
+pub const HOST_WRITE_CHUNK: usize = 64;
+/// Most host bytes taken per poll, so one poll stays short whatever the host sends.
+pub const HOST_READ_BUDGET: usize = 64;
+
+/// The host link: a framer for what arrives and a bounded queue for what leaves.
+#[derive(Debug)]
+pub(crate) struct HostLink {
+    decoder: FrameDecoder,
+    last_rx_us: u64,
+    tx: Deque<u8, HOST_TX_CAPACITY>,
+}
+
+impl HostLink {
+    pub(crate) const fn new() -> Self {
+        Self {
+            decoder: FrameDecoder::new(),
+            last_rx_us: 0,
+            tx: Deque::new(),
+        }
+    }
+
+    /// Takes one byte from the host, noting when it arrived.
+    pub(crate) fn read_byte<H: BytePort>(&mut self, now_us: u64, host: &mut H) -> Option<u8> {
+        let byte = host.read_byte()?;
+        self.last_rx_us = now_us;
+        Some(byte)
+    }
+
+    /// Microseconds since the last host byte arrived.
+    pub(crate) fn quiet_for_us(&self, now_us: u64) -> u64 {
+        now_us.saturating_sub(self.last_rx_us)
+    }
+
+    /// Frames one host byte; calls `on_frame` with each frame it completes.
+    pub(crate) fn frame_byte(&mut self, byte: u8, on_frame: impl FnMut(Frame)) {
+        self.decoder.feed(&[byte], on_frame);
+    }
+
+    /// Drops a partial frame once the host has been quiet for [`timing::HOST_FRAME_GAP_US`]
+    /// (it was cut short); calls `on_frame` with any real frame uncovered by the rescan.
+    pub(crate) fn check_gap(&mut self, now_us: u64, mut on_frame: impl FnMut(Frame)) {
+        if self.decoder.has_partial() && self.quiet_for_us(now_us) >= timing::HOST_FRAME_GAP_US {
+            let mut next = self.decoder.on_quiet_line();
+            while let Some(frame) = next {
+                on_frame(frame);
+                next = self.decoder.next_frame();
+            }
+        }
+    }
+
+    /// Forgets any partial frame (when the mode changes).
+    pub(crate) fn reset_framer(&mut self) {
+        self.decoder = FrameDecoder::new();
+    }
+
+    /// Queues a frame for the host, whole or not at all; false if there was no room.
+    pub(crate) fn send_frame(&mut self, frame: &Frame) -> bool {
+        let mut buf = [0u8; MAX_FRAME_BYTES];
+        match frame.encode(&mut buf).and_then(|n| buf.get(..n)) {
+            Some(bytes) => self.send_bytes(bytes),
+            None => false,
+        }
+    }
+
+    /// Queues bytes for the host, all or none; false if there was no room.
+    pub(crate) fn send_bytes(&mut self, bytes: &[u8]) -> bool {
+        if HOST_TX_CAPACITY - self.tx.len() < bytes.len() {
+            return false;
+        }
+        for &b in bytes {
+            // Cannot fail: room was checked above.
+            let _ = self.tx.push_back(b);
+        }
+        true
+    }
+
+    /// Hands queued bytes to the host port once its transmitter is idle.
+    pub(crate) fn flush<H: BytePort>(&mut self, host: &mut H) {
+        if self.tx.is_empty() || !host.tx_idle() {
+            return;
+        }
+        let mut chunk = [0u8; HOST_WRITE_CHUNK];
+        let mut n = 0;
+        for slot in chunk.iter_mut() {
+            match self.tx.pop_front() {
+                Some(b) => {
+                    *slot = b;
+                    n += 1;
+                }
+                None => break,
+            }
+        }
+        if let Some(bytes) = chunk.get(..n) {
+            host.write(bytes);
+        }
+    }
+}

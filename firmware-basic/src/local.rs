@@ -1,0 +1,293 @@
+//! The commands the Basic answers itself (`protocol.md` section 5, "Answered by the Basic
+//! itself"); they never reach the bus.
+//!
+//! | code | reply |
+//! |---|---|
+//! | 0xA0 set output (pin 2 or 5, level 0/1) | `01` done, `00` refused (bad pin or level) |
+//! | 0xA1 get input (pin 35 or 36) | pin, level; level `FF` (pymycobot: -1) for a bad pin |
+//! | 0xB0 set Wi-Fi SSID/password, 0xB2 set server port | `00`: the Basic has no Wi-Fi |
+//! | 0xB1 get Wi-Fi SSID/password | the text `ssid:  password: ` (pymycobot: `('', '')`) |
+//! | 0xC0 ToF distance | int16 mm; -1 without a sensor |
+//! | 0xC1 Basic version | version x 10 |
+//! | 0xC2 set transponder mode (0 framed, 1 transparent) | `01`, or `00` for another mode |
+//! | 0xC3 get transponder mode | mode |
+//!
+//! 0xB1 answers raw text, not a frame, because that is what pymycobot reads: it decodes the
+//! bytes as UTF-8 and splits them at spaces (a frame would make it raise). A request with a
+//! data length its command does not have is refused with `00`.
+
+use protocol_core::Frame;
+
+use crate::io::{self, BasicIo};
+use crate::status::{BasicError, TransponderMode};
+
+/// Command codes the Basic answers itself.
+pub mod code {
+    /// Set a Basic output pin.
+    pub const SET_BASIC_OUTPUT: u8 = 0xA0;
+    /// Read a Basic input pin.
+    pub const GET_BASIC_INPUT: u8 = 0xA1;
+    /// Set the Wi-Fi SSID and password.
+    pub const SET_SSID_PWD: u8 = 0xB0;
+    /// Get the Wi-Fi SSID and password.
+    pub const GET_SSID_PWD: u8 = 0xB1;
+    /// Set the TCP server port.
+    pub const SET_SERVER_PORT: u8 = 0xB2;
+    /// Read the ToF distance sensor.
+    pub const GET_TOF_DISTANCE: u8 = 0xC0;
+    /// Get the Basic's firmware version.
+    pub const GET_BASIC_VERSION: u8 = 0xC1;
+    /// Set the transponder mode.
+    pub const SET_TRANSPONDER_MODE: u8 = 0xC2;
+    /// Get the transponder mode.
+    pub const GET_TRANSPONDER_MODE: u8 = 0xC3;
+}
+
+/// What 0xB1 answers: no network configured, in the text form pymycobot parses.
+pub const NO_WIFI_TEXT: &[u8] = b"ssid:  password: ";
+
+/// Status byte of a command that was carried out.
+const DONE: u8 = 1;
+/// Status byte of a command that was refused.
+const REFUSED: u8 = 0;
+/// Level byte of 0xA1 for a pin that cannot be read (pymycobot decodes it as -1).
+const NO_LEVEL: u8 = 0xFF;
+
+/// True if the Basic answers `cmd` itself.
+pub fn is_local(cmd: u8) -> bool {
+    matches!(cmd, 0xA0 | 0xA1 | 0xB0..=0xB2 | 0xC0..=0xC3)
+}
+
+/// The Basic's answer to one of its own commands.
+#[derive(Debug, PartialEq, Eq)]
+pub(crate) struct Answer {
+    /// The reply for the host.
+    pub(crate) reply: Reply,
+    /// The transponder mode to switch to after the reply.
+    pub(crate) new_mode: Option<TransponderMode>,
+    /// What went wrong, for the display.
+    pub(crate) error: Option<BasicError>,
+}
+
+/// A reply for the host.
+#[derive(Debug, PartialEq, Eq)]
+pub(crate) enum Reply {
+    /// A reply frame.
+    Frame(Frame),
+    /// Raw bytes (0xB1).
+    Raw(&'static [u8]),
+}
+
+impl Answer {
+    fn data(cmd: u8, data: &[u8]) -> Self {
+        Self {
+            // Local replies carry at most 2 data bytes, so Frame::new cannot fail.
+            reply: Reply::Frame(Frame::new(cmd, data).unwrap_or_default()),
+            new_mode: None,
+            error: None,
+        }
+    }
+
+    fn status(cmd: u8, done: bool) -> Self {
+        Self::data(cmd, &[if done { DONE } else { REFUSED }])
+    }
+
+    fn with_error(mut self, error: BasicError) -> Self {
+        self.error = Some(error);
+        self
+    }
+}
+
+/// Answers `frame` if it is one of the Basic's own commands; `None` if it is for the Atom.
+pub(crate) fn answer<I: BasicIo>(
+    frame: &Frame,
+    io: &mut I,
+    version_x10: u8,
+    mode: TransponderMode,
+) -> Option<Answer> {
+    let cmd = frame.cmd();
+    let answer = match (cmd, frame.data()) {
+        (code::SET_BASIC_OUTPUT, &[pin, level]) => {
+            let high = match level {
+                0 => Some(false),
+                1 => Some(true),
+                _ => None,
+            };
+            match high {
+                _ if !io::is_output_pin(pin) => {
+                    Answer::status(cmd, false).with_error(BasicError::InvalidPin { pin })
+                }
+                Some(high) => Answer::status(cmd, io.set_output(pin, high)),
+                None => Answer::status(cmd, false),
+            }
+        }
+        (code::GET_BASIC_INPUT, &[pin]) => {
+            let level = if io::is_input_pin(pin) {
+                io.read_input(pin)
+            } else {
+                None
+            };
+            let answer = Answer::data(cmd, &[pin, level.map_or(NO_LEVEL, u8::from)]);
+            if io::is_input_pin(pin) {
+                answer
+            } else {
+                answer.with_error(BasicError::InvalidPin { pin })
+            }
+        }
+        (code::GET_SSID_PWD, _) => Answer {
+            reply: Reply::Raw(NO_WIFI_TEXT),
+            new_mode: None,
+            error: None,
+        },
+        (code::SET_SSID_PWD | code::SET_SERVER_PORT, _) => Answer::status(cmd, false),
+        (code::GET_TOF_DISTANCE, &[]) => {
+            let mm = io
+                .tof_distance_mm()
+                .map_or(-1, |mm| i16::try_from(mm).unwrap_or(i16::MAX));
+            Answer::data(cmd, &mm.to_be_bytes())
+        }
+        (code::GET_BASIC_VERSION, &[]) => Answer::data(cmd, &[version_x10]),
+        (code::SET_TRANSPONDER_MODE, &[mode]) => match TransponderMode::from_code(mode) {
+            Some(new_mode) => Answer {
+                new_mode: Some(new_mode),
+                ..Answer::status(cmd, true)
+            },
+            None => Answer::status(cmd, false),
+        },
+        (code::GET_TRANSPONDER_MODE, &[]) => Answer::data(cmd, &[mode.code()]),
+        _ if is_local(cmd) => Answer::status(cmd, false),
+        _ => return None,
+    };
+    Some(answer)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::Buttons;
+
+    /// A board whose outputs and inputs are plain memory.
+    #[derive(Default)]
+    struct FakeIo {
+        outputs: std::vec::Vec<(u8, bool)>,
+        input_35: bool,
+        tof_mm: Option<u16>,
+    }
+
+    impl BasicIo for FakeIo {
+        fn set_output(&mut self, pin: u8, high: bool) -> bool {
+            self.outputs.push((pin, high));
+            true
+        }
+        fn read_input(&mut self, pin: u8) -> Option<bool> {
+            (pin == 35).then_some(self.input_35)
+        }
+        fn tof_distance_mm(&mut self) -> Option<u16> {
+            self.tof_mm
+        }
+        fn buttons(&mut self) -> Buttons {
+            Buttons::default()
+        }
+    }
+
+    fn ask(io: &mut FakeIo, cmd: u8, data: &[u8]) -> Option<Answer> {
+        answer(
+            &Frame::new(cmd, data).unwrap(),
+            io,
+            12,
+            TransponderMode::Framed,
+        )
+    }
+
+    fn reply_bytes(answer: &Answer) -> std::vec::Vec<u8> {
+        match &answer.reply {
+            Reply::Frame(f) => f.to_bytes().to_vec(),
+            Reply::Raw(bytes) => bytes.to_vec(),
+        }
+    }
+
+    #[test]
+    fn set_output_drives_the_valve_pin_and_acks() {
+        let mut io = FakeIo::default();
+        let a = ask(&mut io, 0xA0, &[5, 1]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x03, 0xA0, 0x01, 0xFA]);
+        assert_eq!(io.outputs, [(5, true)]);
+    }
+
+    #[test]
+    fn set_output_refuses_a_pin_the_basic_does_not_have() {
+        let mut io = FakeIo::default();
+        let a = ask(&mut io, 0xA0, &[4, 1]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x03, 0xA0, 0x00, 0xFA]);
+        assert_eq!(a.error, Some(BasicError::InvalidPin { pin: 4 }));
+        assert!(io.outputs.is_empty());
+        let a = ask(&mut io, 0xA0, &[2, 7]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x03, 0xA0, 0x00, 0xFA]);
+        assert!(io.outputs.is_empty());
+    }
+
+    #[test]
+    fn get_input_returns_pin_and_level() {
+        let mut io = FakeIo {
+            input_35: true,
+            ..FakeIo::default()
+        };
+        let a = ask(&mut io, 0xA1, &[35]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x04, 0xA1, 35, 1, 0xFA]);
+        let a = ask(&mut io, 0xA1, &[2]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x04, 0xA1, 2, 0xFF, 0xFA]);
+        assert_eq!(a.error, Some(BasicError::InvalidPin { pin: 2 }));
+    }
+
+    #[test]
+    fn tof_distance_is_big_endian_mm_or_minus_one() {
+        let mut io = FakeIo {
+            tof_mm: Some(300),
+            ..FakeIo::default()
+        };
+        let a = ask(&mut io, 0xC0, &[]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x04, 0xC0, 0x01, 0x2C, 0xFA]);
+        io.tof_mm = None;
+        let a = ask(&mut io, 0xC0, &[]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x04, 0xC0, 0xFF, 0xFF, 0xFA]);
+    }
+
+    #[test]
+    fn version_and_mode_queries() {
+        let mut io = FakeIo::default();
+        let a = ask(&mut io, 0xC1, &[]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x03, 0xC1, 12, 0xFA]);
+        let a = ask(&mut io, 0xC3, &[]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x03, 0xC3, 0, 0xFA]);
+        let a = ask(&mut io, 0xC2, &[1]).unwrap();
+        assert_eq!(a.new_mode, Some(TransponderMode::Transparent));
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x03, 0xC2, 1, 0xFA]);
+        let a = ask(&mut io, 0xC2, &[9]).unwrap();
+        assert_eq!(a.new_mode, None);
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x03, 0xC2, 0, 0xFA]);
+    }
+
+    #[test]
+    fn wifi_commands_answer_without_wifi() {
+        let mut io = FakeIo::default();
+        let a = ask(&mut io, 0xB0, &[]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x03, 0xB0, 0, 0xFA]);
+        let a = ask(&mut io, 0xB2, &[0x23, 0x28]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x03, 0xB2, 0, 0xFA]);
+        let a = ask(&mut io, 0xB1, &[]).unwrap();
+        // pymycobot: data.decode("utf-8").split(" ") -> [1] and [-1].
+        let text = std::str::from_utf8(&reply_bytes(&a)).unwrap().to_owned();
+        let parts: std::vec::Vec<&str> = text.split(' ').collect();
+        assert_eq!((parts[1], parts[parts.len() - 1]), ("", ""));
+    }
+
+    #[test]
+    fn wrong_length_is_refused_and_atom_commands_are_not_local() {
+        let mut io = FakeIo::default();
+        let a = ask(&mut io, 0xA0, &[5]).unwrap();
+        assert_eq!(reply_bytes(&a), [0xFE, 0xFE, 0x03, 0xA0, 0x00, 0xFA]);
+        assert!(io.outputs.is_empty());
+        assert!(ask(&mut io, 0x20, &[]).is_none());
+        assert!(ask(&mut io, 0x10, &[]).is_none());
+    }
+}
