@@ -43,8 +43,7 @@ pub enum CommandError {
     BadGripperSetting(i16),
     /// A drag speed (0x3E) outside 0..=6000 steps/s.
     BadDragSpeed(i16),
-    /// A servo register address below 5 (firmware version, model, id: read-only or fatal to
-    /// change).
+    /// A write to a servo register below 5 (firmware version, model: read-only).
     BadAddress(u8),
 }
 

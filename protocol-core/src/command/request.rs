@@ -24,8 +24,9 @@ pub const MAX_DRAG_SPEED: i16 = 6000;
 pub const HTS_TORQUE_RANGE: core::ops::RangeInclusive<i16> = 150..=980;
 /// Allowed gripper protect current range of 0x39 (pymycobot: 1..=500).
 pub const PROTECT_CURRENT_RANGE: core::ops::RangeInclusive<i16> = 1..=500;
-/// Servo registers below this address (firmware version, model, id) are refused by 0x52/0x53,
-/// as pymycobot does.
+/// Servo registers below this address (firmware version, model) are refused by set servo data
+/// (0x52), as pymycobot does. Reading them is allowed (pymycobot's `is_torque_gripper` reads
+/// register 1 of servo 7).
 pub const MIN_SERVO_ADDRESS: u8 = 5;
 
 /// One host command, typed and validated: every field holds a value the protocol allows.
@@ -292,7 +293,7 @@ pub enum Request {
     GetServoData {
         /// Servo.
         servo: ServoId,
-        /// Register address, >= 5.
+        /// Register address.
         address: u8,
         /// Width byte; `None` for the LEN-4 form (one byte).
         width: Option<DataWidth>,
@@ -891,7 +892,7 @@ impl Request {
             }
             (cmd::GET_SERVO_DATA, 2 | 3) => Self::GetServoData {
                 servo: f.servo()?,
-                address: f.address()?,
+                address: f.u8()?,
                 width: if n == 3 {
                     Some(f.enum_byte(DataWidth::from_u8)?)
                 } else {
