@@ -8,8 +8,9 @@ use clap::Parser;
 use open_mycobot::host::cli::Cli;
 use open_mycobot::host::pty::PseudoTerminal;
 use open_mycobot::host::pty_link::PtyLink;
-use open_mycobot::host::realtime::{HostLink, RealtimeDriver, stop_on_signals};
+use open_mycobot::host::realtime::{RealtimeDriver, ServedRobot, stop_on_signals};
 use open_mycobot::host::tcp::TcpServer;
+use open_mycobot::sim::{RobotConfig, VirtualRobot};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -45,38 +46,12 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
     out.flush()?;
     drop(out);
 
-    RealtimeDriver::new(new_robot(), pty, tcp).run(&stop)?;
+    let robot = ServedRobot {
+        robot: VirtualRobot::new(RobotConfig::default()),
+        link: cli.port.into(),
+    };
+    RealtimeDriver::new(robot, pty, tcp).run(&stop)?;
     drop(link);
-    println!("stopped");
+    let _ = writeln!(std::io::stdout(), "stopped");
     Ok(())
-}
-
-fn new_robot() -> impl HostLink {
-    StandIn::default()
-}
-
-/// TEMPORARY stand-in until `open_mycobot::sim::VirtualRobot` lands: acks every frame.
-#[derive(Default)]
-struct StandIn {
-    now_us: u64,
-    decoder: protocol_core::FrameDecoder,
-    out: Vec<u8>,
-}
-
-impl HostLink for StandIn {
-    fn now_us(&self) -> u64 {
-        self.now_us
-    }
-    fn host_write(&mut self, bytes: &[u8]) {
-        let out = &mut self.out;
-        self.decoder.feed(bytes, |f| {
-            out.extend_from_slice(&[0xFE, 0xFE, 0x03, f.cmd(), 0x01, 0xFA]);
-        });
-    }
-    fn host_read(&mut self, out: &mut Vec<u8>) {
-        out.append(&mut self.out);
-    }
-    fn run_until(&mut self, t_us: u64) {
-        self.now_us = t_us;
-    }
 }

@@ -3,7 +3,9 @@
 use std::net::SocketAddr;
 use std::path::PathBuf;
 
-use clap::Parser;
+use clap::{Parser, ValueEnum};
+
+use crate::sim::HostLink;
 
 /// Virtual myCobot 280 M5: the real Basic and Atom firmware logic, simulated servos, served in
 /// real time on a pseudo-terminal (and optionally TCP) to pymycobot or any serial client.
@@ -20,6 +22,29 @@ pub struct Cli {
     /// Port 0 picks a free port; the address used is printed.
     #[arg(long, value_name = "ADDR:PORT")]
     pub tcp: Option<SocketAddr>,
+
+    /// Which board's USB serial the clients talk to: the Basic (as with the real arm's USB
+    /// cable) or the Atom's own USB port (a direct link to the arm's controller).
+    #[arg(long, value_enum, default_value_t = Port::Basic)]
+    pub port: Port,
+}
+
+/// A USB serial port of the virtual arm.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Port {
+    /// The Basic's USB serial in the base.
+    Basic,
+    /// The Atom's USB serial at the end of the arm.
+    AtomUsb,
+}
+
+impl From<Port> for HostLink {
+    fn from(port: Port) -> Self {
+        match port {
+            Port::Basic => HostLink::Basic,
+            Port::AtomUsb => HostLink::AtomUsb,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -41,6 +66,9 @@ mod tests {
 
         let bare = Cli::try_parse_from(["open-mycobot"]).unwrap();
         assert!(bare.pty_link.is_none() && bare.tcp.is_none());
+        assert_eq!(HostLink::from(bare.port), HostLink::Basic);
+        let atom = Cli::try_parse_from(["open-mycobot", "--port", "atom-usb"]).unwrap();
+        assert_eq!(HostLink::from(atom.port), HostLink::AtomUsb);
 
         assert!(Cli::try_parse_from(["open-mycobot", "--tcp", "9000"]).is_err());
     }

@@ -15,6 +15,8 @@ use std::time::{Duration, Instant};
 use nix::poll::{PollFd, PollFlags, ppoll};
 use nix::sys::time::TimeSpec;
 
+use crate::sim::{HostLink, VirtualRobot};
+
 use super::pty::PseudoTerminal;
 use super::tcp::{ClientId, TcpServer};
 
@@ -25,16 +27,39 @@ pub const TICK: Duration = Duration::from_micros(200);
 /// stopped process), the debt is forgiven instead of fast-forwarding the arm in one jump.
 pub const MAX_CATCH_UP: Duration = Duration::from_millis(50);
 
-/// The robot as the front end sees it: the host side of the Basic's serial line, and time.
-pub trait HostLink {
+/// The robot as the front end sees it: the host end of one serial line, and time.
+pub trait RealtimeRobot {
     /// Virtual time, microseconds since the robot started.
     fn now_us(&self) -> u64;
-    /// Bytes from the host towards the Basic (they go out on the simulated 115200 line).
+    /// Bytes from the host into the robot (they travel the simulated 115200 baud line).
     fn host_write(&mut self, bytes: &[u8]);
-    /// Appends what the Basic sent to the host so far.
+    /// Appends what the robot sent to the host so far.
     fn host_read(&mut self, out: &mut Vec<u8>);
     /// Advances virtual time to `t_us`.
     fn run_until(&mut self, t_us: u64);
+}
+
+/// The virtual robot served on one of its USB ports.
+pub struct ServedRobot {
+    /// The robot.
+    pub robot: VirtualRobot,
+    /// Which board's USB serial the clients talk to.
+    pub link: HostLink,
+}
+
+impl RealtimeRobot for ServedRobot {
+    fn now_us(&self) -> u64 {
+        self.robot.now_us()
+    }
+    fn host_write(&mut self, bytes: &[u8]) {
+        self.robot.link_write(self.link, bytes);
+    }
+    fn host_read(&mut self, out: &mut Vec<u8>) {
+        self.robot.link_read(self.link, out);
+    }
+    fn run_until(&mut self, t_us: u64) {
+        self.robot.run_until(t_us);
+    }
 }
 
 /// Where the robot's replies go: to whoever sent the last request.
@@ -52,7 +77,7 @@ pub struct RealtimeDriver<R> {
     talker: Talker,
 }
 
-impl<R: HostLink> RealtimeDriver<R> {
+impl<R: RealtimeRobot> RealtimeDriver<R> {
     /// Connects `robot` to `pty` and, if given, `tcp`.
     pub fn new(robot: R, pty: PseudoTerminal, tcp: Option<TcpServer>) -> Self {
         Self {
@@ -180,7 +205,7 @@ mod tests {
         outbox: Vec<(u64, u8)>,
     }
 
-    impl HostLink for AckingRobot {
+    impl RealtimeRobot for AckingRobot {
         fn now_us(&self) -> u64 {
             self.now_us
         }
