@@ -28,7 +28,8 @@ def read_frame(port, timeout=1.0):
 
 class PtyTest(unittest.TestCase):
     def raw_port(self):
-        # Take the shared client's lock so its requests do not interleave with ours.
+        # Callers hold the shared client's lock while they use it, so no pymycobot request
+        # interleaves with theirs.
         return serial.Serial(PORT, 115200, timeout=0.05)
 
     def test_raw_request_gets_one_reply_and_no_echo(self):
@@ -83,11 +84,10 @@ class TcpTest(RobotTestCase):
         try:
             self.assertEqual(client.get_angles(), [0.0] * 6)
             target = [15, -10, 20, 5, -15, 30]
-            with arm().lock:  # keep the serial client quiet while the socket client speaks
-                self.assertEqual(client.send_angles(target, 100), 1)
-                reached = wait_until(
-                    lambda: self._within(client.get_angles(), target, 0.2) and client.is_moving() == 0, 6.0
-                )
+            self.assertEqual(client.send_angles(target, 100), 1)
+            reached = wait_until(
+                lambda: self._within(client.get_angles(), target, 0.2) and client.is_moving() == 0, 6.0
+            )
             self.assertTrue(reached, f"TCP client sees {client.get_angles()}")
             self.assertAnglesClose(self.mc.get_angles(), target, msg="the serial client sees the same arm")
         finally:
