@@ -2,6 +2,9 @@
 //! `tools/record_pymycobot.py` into `tests/data/pymycobot_requests.txt`) is found by the frame
 //! decoder, parses to the command the user called, and re-encodes byte for byte.
 
+// Test code: a panic is a test failure with a message.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
+
 use protocol_core::command::*;
 use protocol_core::units::{Centideg, DeciMm, Decideg, SpeedPercent, Steps};
 use protocol_core::{Frame, FrameDecoder};
