@@ -1,19 +1,185 @@
-//! The Atom application: the bus, the servos, the motion and the host commands, polled.
+//! The Atom application: the bus schedule, the servos' state and the robot's actions.
+//!
+//! # Bus schedule
+//! One servo transaction at a time ([`ServoDriver`]). Between transactions the wire stays
+//! silent for [`ATOM_TRANSACTION_GAP_US`] so the Basic can send a host frame; a frame that
+//! starts holds the schedule until it ends, and its reply goes out at once (from cached
+//! state), before the next transaction. Transactions, by priority: servo operations of host
+//! commands (torque, calibration, register access), then the newest goals, then the state
+//! refresh, which reads the 15-byte state block of each servo in turn (one READ per servo, so
+//! a missing servo costs only its own timeout). After every non-refresh transaction one refresh
+//! read runs, so host traffic cannot starve the state refresh.
 
-use protocol_core::BytePort;
-use protocol_core::units::Centideg;
+use heapless::Deque;
+use protocol_core::servo::{Packet, reg, sign_magnitude};
+use protocol_core::timing::{ATOM_TRANSACTION_GAP_US, HOST_FRAME_GAP_US};
+use protocol_core::units::{Centideg, Steps};
+use protocol_core::{BytePort, Frame, FrameDecoder};
 
-use crate::config::{AtomConfig, ConfigError, JOINTS, SERVOS};
+use kinematics_core::LinearPath;
+use protocol_core::command::{MoveMode, Pose};
+
+use crate::bus::{BusEvent, BusReceiver};
+use crate::cartesian::{self, Cartesian};
+use crate::config::{AtomConfig, ConfigError, GRIPPER, JOINTS, JointLimit, SERVOS};
+use crate::driver::{Op, Outcome, ServoDriver};
 use crate::health::ServoHealth;
 use crate::io::AtomIo;
+use crate::motion::{self, Activity, JogDirection};
+use crate::safety::{self, Goal, GoalSet, Refusal};
+
+/// Servo operations waiting for the bus. 16: a command queues at most 3 (EEPROM unlock,
+/// write, lock) or 7 (torque on/off for every servo), and the host waits for each reply.
+const OP_QUEUE: usize = 16;
+
+/// Motions waiting in queue mode (fresh mode 0). 16 moves: a script sending a short path
+/// without waiting; more is refused (answer 0) rather than silently dropped.
+const MOTION_QUEUE: usize = 16;
+
+/// A servo that stopped answering is probed only every this many refresh rounds, so a missing
+/// servo (often the gripper) does not cost its timeout in every round.
+const LOST_SERVO_PROBE_ROUNDS: u8 = 8;
+
+/// Which host link a request came from (its reply goes back there).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Link {
+    /// The shared bus (requests forwarded by the Basic).
+    Bus,
+    /// The Atom's own USB serial.
+    Usb,
+}
+
+/// What to do when a queued servo operation finishes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Then {
+    /// Nothing (the host was already answered).
+    Nothing,
+    /// Answer get servo data (0x53) with the value read.
+    ReplyServoData {
+        /// Where the request came from.
+        link: Link,
+        /// True for the 2-byte form.
+        two_bytes: bool,
+    },
+}
+
+/// A servo operation waiting for the bus.
+#[derive(Clone, Debug)]
+struct Job {
+    op: Op,
+    then: Then,
+    attempt: u8,
+}
+
+/// A queued motion (queue mode).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Target {
+    /// Joint targets; `None` leaves a joint where it is going.
+    pub angles: [Option<Centideg>; JOINTS],
+    /// Speed, percent.
+    pub speed_percent: u8,
+}
+
+/// Why an action was not carried out. Converted to the 0x07 error code in one place
+/// ([`ActionError::error_code`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ActionError {
+    /// The arm is powered off.
+    PoweredOff,
+    /// Joint `index` (0-based) would leave its limits.
+    JointLimit(usize),
+    /// The gripper value or servo goal is out of range.
+    GripperRange,
+    /// The pose has no inverse-kinematics solution.
+    Unreachable,
+    /// A straight line has no continuous solution.
+    NoLinearSolution,
+    /// A queue is full; the host may retry.
+    Busy,
+    /// The command cannot be carried out for another reason (bad register, missing servo).
+    Invalid,
+}
+
+impl ActionError {
+    /// The error code 0x07 reports for this failure (`protocol.md`), if it has one.
+    pub(crate) fn error_code(self) -> Option<u8> {
+        match self {
+            Self::JointLimit(j) => Some(j as u8 + 1),
+            Self::Unreachable => Some(32),
+            Self::NoLinearSolution => Some(33),
+            _ => None,
+        }
+    }
+}
+
+impl From<Refusal> for ActionError {
+    fn from(r: Refusal) -> Self {
+        match r {
+            Refusal::PoweredOff => Self::PoweredOff,
+            Refusal::JointLimit(j) => Self::JointLimit(j),
+            Refusal::GripperRange => Self::GripperRange,
+        }
+    }
+}
 
 /// The Atom firmware. Create it once with [`Atom::new`] and call [`Atom::poll`] in a loop.
 pub struct Atom {
-    config: AtomConfig,
+    pub(crate) config: AtomConfig,
     config_error: Option<ConfigError>,
-    powered: bool,
-    error_code: u8,
-    health: [ServoHealth; SERVOS],
+    // Links.
+    rx: BusReceiver,
+    usb_frames: FrameDecoder,
+    usb_last_rx_us: u64,
+    bus_reply: Option<Frame>,
+    // Bus schedule.
+    driver: ServoDriver,
+    jobs: Deque<Job, OP_QUEUE>,
+    pending_goals: Option<safety::SafeGoals>,
+    refresh_next: usize,
+    refresh_round: u8,
+    owe_refresh: bool,
+    refresh_rounds_done: u32,
+    // Robot state.
+    pub(crate) powered: bool,
+    pub(crate) free_mode: bool,
+    pub(crate) fresh_mode: bool,
+    pub(crate) error_code: u8,
+    pub(crate) limits: [JointLimit; JOINTS],
+    pub(crate) speed_percent: u8,
+    pub(crate) health: [ServoHealth; SERVOS],
+    pub(crate) last_goal: [Option<Steps>; SERVOS],
+    pub(crate) activity: Activity,
+    pub(crate) paused: Option<Target>,
+    queue: Deque<Target, MOTION_QUEUE>,
+    last_host_cmd_us: u64,
+    button_was_pressed: bool,
+    pub(crate) gripper: crate::config::GripperRange,
+    pub(crate) gripper_torque: i16,
+    pub(crate) gripper_protect_current: i16,
+    pub(crate) cart: Cartesian,
+    /// A straight-line move or a Cartesian jog being stepped.
+    stepper: Option<Stepper>,
+}
+
+/// A motion stepped in Cartesian space every interpolation period.
+#[derive(Clone, Debug)]
+enum Stepper {
+    /// A straight line (send coords mode 1).
+    Line {
+        path: LinearPath,
+        next_us: u64,
+        target: Pose,
+    },
+    /// A continuous Cartesian jog: axis 0..2 = x, y, z, 3..5 = rotation about base x, y, z.
+    Jog {
+        axis: usize,
+        direction: JogDirection,
+        speed_percent: u8,
+        next_us: u64,
+        /// The joint angles last commanded (the next step starts from here, not from the
+        /// lagging present position).
+        angles: [Centideg; JOINTS],
+    },
 }
 
 impl Atom {
@@ -24,12 +190,43 @@ impl Atom {
             Ok(()) => (config, None),
             Err(e) => (AtomConfig::default(), Some(e)),
         };
+        let mut health = [ServoHealth::default(); SERVOS];
+        for h in &mut health {
+            h.position = Steps(crate::config::STEPS_ZERO as i16);
+            h.torque_on = config.powered_at_boot;
+        }
         Self {
             config,
             config_error,
+            rx: BusReceiver::new(),
+            usb_frames: FrameDecoder::new(),
+            usb_last_rx_us: 0,
+            bus_reply: None,
+            driver: ServoDriver::new(config.timing.reply_margin_us),
+            jobs: Deque::new(),
+            pending_goals: None,
+            refresh_next: 0,
+            refresh_round: 0,
+            owe_refresh: false,
+            refresh_rounds_done: 0,
             powered: config.powered_at_boot,
+            free_mode: false,
+            fresh_mode: true,
             error_code: 0,
-            health: [ServoHealth::default(); SERVOS],
+            limits: config.joint_limits,
+            speed_percent: 100,
+            health,
+            last_goal: [None; SERVOS],
+            activity: Activity::Idle,
+            paused: None,
+            queue: Deque::new(),
+            last_host_cmd_us: 0,
+            button_was_pressed: false,
+            gripper: config.gripper,
+            gripper_torque: 300,
+            gripper_protect_current: 300,
+            cart: Cartesian::new(&config.joint_limits),
+            stepper: None,
         }
     }
 
@@ -44,8 +241,557 @@ impl Atom {
         usb: &mut U,
         io: &mut I,
     ) {
-        let _ = (now_us, bus, usb, io);
+        self.receive_bus(now_us, bus, usb, io);
+        self.receive_usb(now_us, usb, io);
+        if let Some((op, outcome)) = self.driver.poll(now_us, bus) {
+            self.finish(op, outcome, usb);
+        }
+        self.update_motion(now_us);
+        self.update_button(io);
+        self.schedule_bus(now_us, bus);
     }
+
+    fn receive_bus<B: BytePort, U: BytePort, I: AtomIo>(
+        &mut self,
+        now_us: u64,
+        bus: &mut B,
+        usb: &mut U,
+        io: &mut I,
+    ) {
+        // Bounded: at most what arrived since the last poll, plus a cap against a stuck port.
+        for _ in 0..512 {
+            let Some(byte) = bus.read_byte() else { break };
+            let mut events: heapless::Vec<BusEvent, 4> = heapless::Vec::new();
+            self.rx.push(now_us, byte, &mut |e| {
+                let _ = events.push(e);
+            });
+            for e in events {
+                self.on_bus_event(now_us, e, usb, io);
+            }
+        }
+        let mut events: heapless::Vec<BusEvent, 4> = heapless::Vec::new();
+        self.rx.on_time(now_us, &mut |e| {
+            let _ = events.push(e);
+        });
+        for e in events {
+            self.on_bus_event(now_us, e, usb, io);
+        }
+    }
+
+    fn on_bus_event<U: BytePort, I: AtomIo>(
+        &mut self,
+        now_us: u64,
+        event: BusEvent,
+        usb: &mut U,
+        io: &mut I,
+    ) {
+        match event {
+            BusEvent::Frame(frame) => {
+                if let Some(reply) = self.handle_frame(now_us, &frame, Link::Bus, io) {
+                    // A newer request replaces an unsent reply: the host has given up on it.
+                    self.bus_reply = Some(reply);
+                }
+            }
+            BusEvent::Packet(packet) => {
+                if let Some((op, outcome)) = self.driver.on_packet(packet) {
+                    self.finish(op, outcome, usb);
+                }
+            }
+        }
+    }
+
+    fn receive_usb<U: BytePort, I: AtomIo>(&mut self, now_us: u64, usb: &mut U, io: &mut I) {
+        for _ in 0..512 {
+            let Some(byte) = usb.read_byte() else { break };
+            self.usb_last_rx_us = now_us;
+            let mut next = self.usb_frames.push(byte);
+            while let Some(frame) = next {
+                if let Some(reply) = self.handle_frame(now_us, &frame, Link::Usb, io) {
+                    usb.write(&reply.to_bytes());
+                }
+                next = self.usb_frames.next_frame();
+            }
+        }
+        if self.usb_frames.has_partial()
+            && now_us.saturating_sub(self.usb_last_rx_us) >= HOST_FRAME_GAP_US
+        {
+            let mut next = self.usb_frames.on_quiet_line();
+            while let Some(frame) = next {
+                if let Some(reply) = self.handle_frame(now_us, &frame, Link::Usb, io) {
+                    usb.write(&reply.to_bytes());
+                }
+                next = self.usb_frames.next_frame();
+            }
+        }
+    }
+
+    fn handle_frame<I: AtomIo>(
+        &mut self,
+        now_us: u64,
+        frame: &Frame,
+        link: Link,
+        io: &mut I,
+    ) -> Option<Frame> {
+        self.last_host_cmd_us = now_us;
+        crate::commands::handle(self, now_us, frame, link, io)
+    }
+
+    /// Starts the next bus action if the wire is ours: a held host reply first, then a servo
+    /// transaction once the wire has been quiet for the transaction gap.
+    fn schedule_bus<B: BytePort>(&mut self, now_us: u64, bus: &mut B) {
+        if self.driver.busy() {
+            return;
+        }
+        if let Some(reply) = self.bus_reply.take() {
+            let bytes = reply.to_bytes();
+            bus.write(&bytes);
+            self.rx.on_transmit(now_us, &bytes);
+            return;
+        }
+        if self.rx.frame_in_progress()
+            || !bus.tx_idle()
+            || self.rx.quiet_us(now_us) < ATOM_TRANSACTION_GAP_US
+        {
+            return;
+        }
+        let op = if self.owe_refresh {
+            self.owe_refresh = false;
+            self.next_refresh_op()
+        } else if let Some(job) = self.jobs.front() {
+            self.owe_refresh = true;
+            Some(job.op.clone())
+        } else if let Some(goals) = self.pending_goals.take() {
+            self.owe_refresh = true;
+            goals.sync_write(&self.config.servo_ids).map(Op::Broadcast)
+        } else {
+            self.next_refresh_op()
+        };
+        if let Some(op) = op {
+            self.driver.start(now_us, op, bus, &mut self.rx);
+        }
+    }
+
+    /// The state read of the next servo in the refresh round (lost servos only now and then).
+    fn next_refresh_op(&mut self) -> Option<Op> {
+        for _ in 0..SERVOS {
+            let index = self.refresh_next;
+            self.refresh_next += 1;
+            if self.refresh_next >= SERVOS {
+                self.refresh_next = 0;
+                self.refresh_round = self.refresh_round.wrapping_add(1);
+                self.refresh_rounds_done = self.refresh_rounds_done.wrapping_add(1);
+            }
+            let lost = self
+                .health
+                .get(index)
+                .is_some_and(|h| !h.answering && h.misses >= self.config.timing.misses_before_lost);
+            if lost && !self.refresh_round.is_multiple_of(LOST_SERVO_PROBE_ROUNDS) {
+                continue;
+            }
+            let id = *self.config.servo_ids.get(index)?;
+            return Some(Op::Read {
+                id,
+                addr: reg::STATE_BLOCK,
+                count: reg::STATE_BLOCK_LEN,
+            });
+        }
+        None
+    }
+
+    /// Applies the result of a finished transaction.
+    fn finish<U: BytePort>(&mut self, op: Op, outcome: Outcome, usb: &mut U) {
+        let index = self.config.servo_ids.iter().position(|&id| id == op.id());
+        let is_state_read = matches!(
+            op,
+            Op::Read {
+                addr: reg::STATE_BLOCK,
+                count: reg::STATE_BLOCK_LEN,
+                ..
+            }
+        );
+        let job_matches = self.jobs.front().is_some_and(|j| j.op == op);
+        if is_state_read && !job_matches {
+            if let Some(h) = index.and_then(|i| self.health.get_mut(i)) {
+                match &outcome {
+                    Outcome::Answered(p) => apply_state(h, p),
+                    _ => {
+                        h.comm_errors = h.comm_errors.wrapping_add(1);
+                        h.misses = h.misses.saturating_add(1);
+                        if h.misses >= self.config.timing.misses_before_lost {
+                            h.answering = false;
+                        }
+                    }
+                }
+            }
+            return;
+        }
+        if !job_matches {
+            return;
+        }
+        if let (Some(h), Outcome::Answered(p)) =
+            (index.and_then(|i| self.health.get_mut(i)), &outcome)
+        {
+            h.fault_bits = p.code();
+        }
+        if outcome == Outcome::TimedOut {
+            if let Some(job) = self.jobs.front_mut()
+                && job.attempt < self.config.timing.retries
+            {
+                job.attempt += 1;
+                return;
+            }
+            if let Some(h) = index.and_then(|i| self.health.get_mut(i)) {
+                h.comm_errors = h.comm_errors.wrapping_add(1);
+            }
+        }
+        let Some(job) = self.jobs.pop_front() else {
+            return;
+        };
+        if let Then::ReplyServoData { link, two_bytes } = job.then {
+            let value: i16 = match &outcome {
+                Outcome::Answered(p) if two_bytes => p.u16_at(0).map_or(-1, |v| v as i16),
+                Outcome::Answered(p) => p.params().first().map_or(-1, |&v| i16::from(v)),
+                _ => -1,
+            };
+            let reply = if two_bytes {
+                Frame::new(crate::commands::GET_SERVO_DATA, &value.to_be_bytes())
+            } else {
+                Frame::new(crate::commands::GET_SERVO_DATA, &[value as u8])
+            };
+            if let Some(reply) = reply {
+                match link {
+                    Link::Bus => self.bus_reply = Some(reply),
+                    Link::Usb => usb.write(&reply.to_bytes()),
+                }
+            }
+        }
+    }
+
+    /// Queues a servo operation. `false` if the queue is full.
+    pub(crate) fn queue_op(&mut self, op: Op, then: Then) -> bool {
+        self.jobs
+            .push_back(Job {
+                op,
+                then,
+                attempt: 0,
+            })
+            .is_ok()
+    }
+
+    /// Room for `n` more servo operations.
+    pub(crate) fn op_room(&self) -> usize {
+        OP_QUEUE - self.jobs.len()
+    }
+
+    /// The safety choke point's caller: checks `goals` and, if they pass, makes them the next
+    /// goals written to the servos (merged with goals not sent yet). Switches torque on for a
+    /// released servo that gets a goal.
+    pub(crate) fn send_goals(&mut self, goals: GoalSet) -> Result<(), ActionError> {
+        let safe = safety::check(&self.config, &self.limits, self.powered, goals)?;
+        let mut merged: GoalSet = self
+            .pending_goals
+            .take()
+            .map(|p| *p.goals())
+            .unwrap_or([None; SERVOS]);
+        for (i, (slot, new)) in merged.iter_mut().zip(safe.goals()).enumerate() {
+            if let Some(g) = new {
+                *slot = Some(*g);
+                if let Some(last) = self.last_goal.get_mut(i) {
+                    *last = Some(g.position);
+                }
+                let torque_off = self.health.get(i).is_some_and(|h| !h.torque_on);
+                if torque_off {
+                    self.set_torque(i, true);
+                }
+            }
+        }
+        // Re-checking the merge cannot fail (each goal passed on its own), but keeps the
+        // invariant local: only checked goals are ever pending.
+        self.pending_goals = Some(safety::check(
+            &self.config,
+            &self.limits,
+            self.powered,
+            merged,
+        )?);
+        Ok(())
+    }
+
+    /// Queues torque on/off for servo `index`.
+    pub(crate) fn set_torque(&mut self, index: usize, on: bool) -> bool {
+        let Some(&id) = self.config.servo_ids.get(index) else {
+            return false;
+        };
+        let queued = Op::write(id, reg::TORQUE_ENABLE, &[u8::from(on)])
+            .is_some_and(|op| self.queue_op(op, Then::Nothing));
+        if queued && let Some(h) = self.health.get_mut(index) {
+            h.torque_on = on;
+        }
+        queued
+    }
+
+    // ----- motion -------------------------------------------------------------------------
+
+    /// Present encoder positions of the joints.
+    pub(crate) fn present_steps(&self) -> [Steps; JOINTS] {
+        core::array::from_fn(|j| self.health.get(j).map(|h| h.position).unwrap_or_default())
+    }
+
+    /// Checks a target against power and limits without moving.
+    pub(crate) fn check_target(&self, target: &Target) -> Result<(), ActionError> {
+        if !self.powered {
+            return Err(ActionError::PoweredOff);
+        }
+        for (j, (a, l)) in target.angles.iter().zip(&self.limits).enumerate() {
+            if let Some(a) = a
+                && !l.contains(*a)
+            {
+                return Err(ActionError::JointLimit(j));
+            }
+        }
+        Ok(())
+    }
+
+    /// Accepts a motion: in fresh mode it starts now (replacing the current one), in queue
+    /// mode it waits for the motions before it.
+    pub(crate) fn submit_motion(&mut self, now_us: u64, target: Target) -> Result<(), ActionError> {
+        self.check_target(&target)?;
+        if self.fresh_mode {
+            self.queue.clear();
+            self.paused = None;
+            self.start_motion(now_us, target, false)
+        } else if self.activity == Activity::Idle && self.queue.is_empty() && self.paused.is_none()
+        {
+            self.start_motion(now_us, target, false)
+        } else {
+            self.queue.push_back(target).map_err(|_| ActionError::Busy)
+        }
+    }
+
+    /// Sends the goals of `target` now.
+    pub(crate) fn start_motion(
+        &mut self,
+        now_us: u64,
+        target: Target,
+        jog: bool,
+    ) -> Result<(), ActionError> {
+        self.check_target(&target)?;
+        let steps: [Option<Steps>; JOINTS] = core::array::from_fn(|j| {
+            target
+                .angles
+                .get(j)
+                .copied()
+                .flatten()
+                .map(|a| self.config.angle_to_steps(j, a))
+        });
+        let (goals, duration_us) = motion::plan_joint_move(
+            &self.config,
+            &self.present_steps(),
+            &steps,
+            target.speed_percent,
+        );
+        self.send_goals(goals)?;
+        let present = self.present_angles();
+        let full: [Centideg; JOINTS] = core::array::from_fn(|j| {
+            target
+                .angles
+                .get(j)
+                .copied()
+                .flatten()
+                .or_else(|| self.planned_angle(j))
+                .unwrap_or(present.get(j).copied().unwrap_or_default())
+        });
+        self.activity = Activity::Moving {
+            target: full,
+            started_us: now_us,
+            duration_us,
+            jog,
+        };
+        Ok(())
+    }
+
+    /// The angle joint `j` was last sent to, if any.
+    fn planned_angle(&self, j: usize) -> Option<Centideg> {
+        self.last_goal
+            .get(j)
+            .copied()
+            .flatten()
+            .map(|s| self.config.steps_to_angle(j, s))
+    }
+
+    /// The target being executed (or the present angles when idle).
+    pub(crate) fn planned_angles(&self) -> [Centideg; JOINTS] {
+        match self.activity {
+            Activity::Moving { target, .. } => target,
+            Activity::Idle => self.present_angles(),
+        }
+    }
+
+    /// Holds every joint where it is now and forgets the motion (and, if `clear`, the queue).
+    pub(crate) fn halt(&mut self, clear: bool) {
+        self.activity = Activity::Idle;
+        self.stepper = None;
+        if clear {
+            self.queue.clear();
+            self.paused = None;
+        }
+        if !self.powered {
+            return;
+        }
+        let present = self.present_steps();
+        let accel = motion::joint_accel_register(&self.config);
+        let speed = motion::joint_speed_steps(&self.config, 100) as u16;
+        let mut goals: GoalSet = [None; SERVOS];
+        for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
+            let torque = self.health.get(j).is_some_and(|h| h.torque_on);
+            if let (true, Some(&p)) = (torque, present.get(j)) {
+                *slot = Some(Goal {
+                    position: p,
+                    speed_steps_per_s: speed,
+                    accel,
+                });
+            }
+        }
+        // A present position outside the limits (arm moved by hand) is not sent: that joint
+        // keeps its previous goal.
+        for j in 0..JOINTS {
+            let mut one: GoalSet = [None; SERVOS];
+            if let (Some(slot), Some(g)) = (one.get_mut(j), goals.get(j).copied().flatten()) {
+                *slot = Some(g);
+                let _ = self.send_goals(one);
+            }
+        }
+    }
+
+    /// Pauses the current motion (it can be resumed).
+    pub(crate) fn pause(&mut self) {
+        if let Activity::Moving {
+            target, jog: false, ..
+        } = self.activity
+        {
+            self.paused = Some(Target {
+                angles: target.map(Some),
+                speed_percent: self.speed_percent,
+            });
+        }
+        self.halt(false);
+    }
+
+    /// Resumes a paused motion.
+    pub(crate) fn resume(&mut self, now_us: u64) -> Result<(), ActionError> {
+        match self.paused.take() {
+            Some(t) => self.start_motion(now_us, t, false),
+            None => Ok(()),
+        }
+    }
+
+    /// Starts a continuous jog of joint `j` toward its limit.
+    pub(crate) fn jog_joint(
+        &mut self,
+        now_us: u64,
+        j: usize,
+        direction: JogDirection,
+        speed_percent: u8,
+    ) -> Result<(), ActionError> {
+        let limit = self.limits.get(j).ok_or(ActionError::Invalid)?;
+        let end = match direction {
+            JogDirection::Positive => limit.max,
+            JogDirection::Negative => limit.min,
+        };
+        let mut angles = [None; JOINTS];
+        if let Some(slot) = angles.get_mut(j) {
+            *slot = Some(end);
+        }
+        self.queue.clear();
+        self.paused = None;
+        self.start_motion(
+            now_us,
+            Target {
+                angles,
+                speed_percent,
+            },
+            true,
+        )
+    }
+
+    fn update_motion(&mut self, now_us: u64) {
+        self.update_stepper(now_us);
+        if let Activity::Moving {
+            target,
+            started_us,
+            duration_us,
+            jog,
+        } = self.activity
+        {
+            let elapsed = now_us.saturating_sub(started_us);
+            let arrived = motion::angles_match(&self.present_angles(), &target)
+                && !self.health.iter().take(JOINTS).any(|h| h.moving);
+            let host_silent =
+                now_us.saturating_sub(self.last_host_cmd_us) >= self.config.timing.jog_watchdog_us;
+            if jog && host_silent {
+                self.halt(true);
+            } else if arrived || elapsed > duration_us + motion::MOVE_OVERTIME_US {
+                self.activity = Activity::Idle;
+            }
+        }
+        if self.activity == Activity::Idle
+            && self.paused.is_none()
+            && let Some(next) = self.queue.pop_front()
+            && let Err(e) = self.start_motion(now_us, next, false)
+        {
+            self.record(e);
+        }
+    }
+
+    /// Free mode: the button releases the joints while held (to move the arm by hand).
+    fn update_button<I: AtomIo>(&mut self, io: &mut I) {
+        let pressed = io.button_pressed();
+        if pressed != self.button_was_pressed && self.free_mode && self.powered {
+            for j in 0..JOINTS {
+                self.set_torque(j, !pressed);
+            }
+            if pressed {
+                self.activity = Activity::Idle;
+            }
+        }
+        self.button_was_pressed = pressed;
+    }
+
+    /// Records a failure's error code for 0x07.
+    pub(crate) fn record(&mut self, e: ActionError) {
+        if let Some(code) = e.error_code() {
+            self.error_code = code;
+        }
+    }
+
+    /// True while the arm moves (a motion runs or a servo reports moving).
+    pub fn is_moving(&self) -> bool {
+        self.activity != Activity::Idle
+            || self
+                .health
+                .iter()
+                .take(JOINTS)
+                .any(|h| h.answering && h.moving)
+    }
+
+    /// Powers the arm on: torque on for every servo.
+    pub(crate) fn power_on(&mut self) -> bool {
+        self.powered = true;
+        self.free_mode = false;
+        let ok = (0..SERVOS).all(|i| self.set_torque(i, true));
+        // Hold where the arm is now instead of jumping to an old goal.
+        self.halt(true);
+        ok
+    }
+
+    /// Powers the arm off: motion forgotten, torque off for every servo.
+    pub(crate) fn power_off(&mut self) -> bool {
+        self.halt(true);
+        self.pending_goals = None;
+        self.powered = false;
+        (0..SERVOS).all(|i| self.set_torque(i, false))
+    }
+
+    // ----- accessors ----------------------------------------------------------------------
 
     /// The configuration in use.
     pub fn config(&self) -> &AtomConfig {
@@ -78,5 +824,257 @@ impl Atom {
             let steps = self.health.get(j).map(|h| h.position).unwrap_or_default();
             self.config.steps_to_angle(j, steps)
         })
+    }
+
+    /// Current joint limits (settable at run time with 0x4C/0x4D).
+    pub fn joint_limits(&self) -> &[JointLimit; JOINTS] {
+        &self.limits
+    }
+
+    /// Completed state-refresh rounds (every servo read once per round). Wraps.
+    pub fn refresh_rounds(&self) -> u32 {
+        self.refresh_rounds_done
+    }
+
+    /// Gripper opening 0 (closed) ..= 100 (open) from its present position.
+    pub fn gripper_value(&self) -> u8 {
+        let pos = i32::from(self.health.get(GRIPPER).map(|h| h.position.0).unwrap_or(0));
+        let closed = i32::from(self.gripper.closed.0);
+        let open = i32::from(self.gripper.open.0);
+        let span = open - closed;
+        if span == 0 {
+            return 0;
+        }
+        ((pos - closed) * 100 / span).clamp(0, 100) as u8
+    }
+}
+
+/// Applies a state-block read (`servo-bus.md`: addresses 56..=70) to a servo's health.
+fn apply_state(h: &mut ServoHealth, p: &Packet) {
+    let at = |addr: u8| usize::from(addr - reg::STATE_BLOCK);
+    let byte = |addr: u8| p.params().get(at(addr)).copied().unwrap_or(0);
+    let word = |addr: u8| p.u16_at(at(addr)).unwrap_or(0);
+    h.answering = true;
+    h.ever_answered = true;
+    h.misses = 0;
+    h.position = Steps(sign_magnitude(word(reg::PRESENT_POSITION), 15));
+    h.speed_steps_per_s = sign_magnitude(word(reg::PRESENT_SPEED), 15);
+    h.load_permille = sign_magnitude(word(reg::PRESENT_LOAD), 10);
+    h.voltage_decivolt = byte(reg::PRESENT_VOLTAGE);
+    h.temperature_c = byte(reg::PRESENT_TEMPERATURE);
+    h.fault_bits = p.code() | byte(reg::STATUS);
+    h.moving = byte(reg::MOVING) != 0;
+    h.current_raw = sign_magnitude(word(reg::PRESENT_CURRENT), 15);
+}
+
+impl Atom {
+    /// Forgets queued motions (0x05); the current one continues.
+    pub(crate) fn clear_queue(&mut self) {
+        self.queue.clear();
+    }
+
+    /// The end pose at the present joint angles.
+    pub(crate) fn present_coords(&mut self) -> Pose {
+        let angles = self.present_angles();
+        self.cart.forward(&angles)
+    }
+
+    /// The end pose of the target being executed (present pose when idle).
+    pub(crate) fn planned_coords(&mut self) -> Pose {
+        if let Some(Stepper::Line { target, .. }) = &self.stepper {
+            return *target;
+        }
+        let angles = self.planned_angles();
+        self.cart.forward(&angles)
+    }
+
+    /// Moves the end to `pose`: joint-interpolated (mode 0) or along a straight line (mode 1).
+    pub(crate) fn move_to_pose(
+        &mut self,
+        now_us: u64,
+        pose: Pose,
+        speed_percent: u8,
+        mode: MoveMode,
+    ) -> Result<(), ActionError> {
+        if !self.powered {
+            return Err(ActionError::PoweredOff);
+        }
+        let seed = self.planned_angles();
+        let angles = self
+            .cart
+            .inverse(&pose, &seed)
+            .map_err(|_| ActionError::Unreachable)?;
+        let target = Target {
+            angles: angles.map(Some),
+            speed_percent,
+        };
+        self.check_target(&target)?;
+        if mode == MoveMode::Joint || !self.fresh_mode && self.activity != Activity::Idle {
+            return self.submit_motion(now_us, target);
+        }
+        let start = cartesian::joints(&self.present_angles());
+        let step = self.linear_step_decimm(speed_percent);
+        let path = LinearPath::new(self.cart.model(), &start, &cartesian::to_kin(&pose), step)
+            .map_err(|_| ActionError::Unreachable)?;
+        self.queue.clear();
+        self.paused = None;
+        self.stepper = Some(Stepper::Line {
+            path,
+            next_us: now_us,
+            target: pose,
+        });
+        self.activity = Activity::Moving {
+            target: angles,
+            started_us: now_us,
+            duration_us: u64::MAX / 4,
+            jog: false,
+        };
+        Ok(())
+    }
+
+    /// Distance covered in one interpolation period at `speed_percent`, tenth-millimetres.
+    fn linear_step_decimm(&self, speed_percent: u8) -> i32 {
+        let v = u64::from(self.config.motion.linear_speed_decimm_per_s)
+            * u64::from(speed_percent.clamp(1, 100))
+            / 100;
+        (v * self.config.timing.interpolation_period_us / 1_000_000).max(1) as i32
+    }
+
+    /// Starts a continuous Cartesian jog (0x31, 0x32): `axis` 0..2 along x, y, z, 3..5 about
+    /// the base x, y, z axes.
+    pub(crate) fn jog_pose(
+        &mut self,
+        now_us: u64,
+        axis: usize,
+        direction: JogDirection,
+        speed_percent: u8,
+    ) -> Result<(), ActionError> {
+        if !self.powered {
+            return Err(ActionError::PoweredOff);
+        }
+        self.halt(true);
+        self.stepper = Some(Stepper::Jog {
+            axis,
+            direction,
+            speed_percent,
+            next_us: now_us,
+            angles: self.present_angles(),
+        });
+        self.activity = Activity::Moving {
+            target: self.present_angles(),
+            started_us: now_us,
+            duration_us: u64::MAX / 4,
+            jog: true,
+        };
+        Ok(())
+    }
+
+    /// Takes the next step of a straight line or Cartesian jog when it is due.
+    fn update_stepper(&mut self, now_us: u64) {
+        let period = self.config.timing.interpolation_period_us;
+        let Some(stepper) = self.stepper.as_mut() else {
+            return;
+        };
+        let next_angles = match stepper {
+            Stepper::Line { path, next_us, .. } => {
+                if now_us < *next_us {
+                    return;
+                }
+                *next_us = now_us + period;
+                match path.next(self.cart.model()) {
+                    None => {
+                        // Last step sent: the move ends when the joints arrive.
+                        self.stepper = None;
+                        return;
+                    }
+                    Some(Err(e)) => Err(if e.protocol_code() == 33 {
+                        ActionError::NoLinearSolution
+                    } else {
+                        ActionError::Unreachable
+                    }),
+                    Some(Ok(q)) => Ok(cartesian::angles(&q)),
+                }
+            }
+            Stepper::Jog {
+                axis,
+                direction,
+                speed_percent,
+                next_us,
+                angles,
+            } => {
+                if now_us < *next_us {
+                    return;
+                }
+                *next_us = now_us + period;
+                let (axis, sign, pct, from) = (*axis, direction.sign(), *speed_percent, *angles);
+                let pose = self.cart.forward(&from);
+                let target = if axis < 3 {
+                    let step = self.linear_step_decimm(pct) * sign;
+                    let mut a = pose.to_array();
+                    if let Some(v) = a.get_mut(axis) {
+                        *v = (i32::from(*v) + step).clamp(-32_768, 32_767) as i16;
+                    }
+                    Pose::from_array(a)
+                } else {
+                    let v = u64::from(self.config.motion.rotation_speed_centideg_per_s)
+                        * u64::from(pct.clamp(1, 100))
+                        / 100;
+                    let step = (v * period / 1_000_000).max(1) as i32 * sign;
+                    self.cart
+                        .rotate_about_base(&pose, axis - 3, Centideg(step as i16))
+                };
+                self.cart
+                    .inverse(&target, &from)
+                    .map_err(|_| ActionError::Unreachable)
+            }
+        };
+        match next_angles.and_then(|q| self.step_to(&q, period)) {
+            Ok(q) => {
+                if let Some(Stepper::Jog { angles, .. }) = self.stepper.as_mut() {
+                    *angles = q;
+                }
+            }
+            Err(e) => {
+                self.record(e);
+                self.halt(true);
+            }
+        }
+    }
+
+    /// Sends goals that reach joint angles `q` in one interpolation period.
+    fn step_to(
+        &mut self,
+        q: &[Centideg; JOINTS],
+        period_us: u64,
+    ) -> Result<[Centideg; JOINTS], ActionError> {
+        self.check_target(&Target {
+            angles: q.map(Some),
+            speed_percent: 100,
+        })?;
+        let present = self.present_steps();
+        let accel = motion::joint_accel_register(&self.config);
+        let max_speed = motion::joint_speed_steps(&self.config, 100);
+        let mut goals: GoalSet = [None; SERVOS];
+        for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
+            let goal = self
+                .config
+                .angle_to_steps(j, q.get(j).copied().unwrap_or_default());
+            let from = present.get(j).map_or(goal.0, |p| p.0);
+            let travel = u64::from((i32::from(goal.0) - i32::from(from)).unsigned_abs());
+            let speed = (travel * 1_000_000 / period_us.max(1)).clamp(1, u64::from(max_speed));
+            *slot = Some(Goal {
+                position: goal,
+                speed_steps_per_s: speed as u16,
+                accel,
+            });
+        }
+        self.send_goals(goals)?;
+        if let Activity::Moving {
+            target, jog: true, ..
+        } = &mut self.activity
+        {
+            *target = *q;
+        }
+        Ok(*q)
     }
 }

@@ -73,7 +73,9 @@ impl Op {
                 count: *count,
             }
             .to_packet(*id),
-            Self::Write { id, addr, data } => Instruction::Write { addr: *addr, data }.to_packet(*id),
+            Self::Write { id, addr, data } => {
+                Instruction::Write { addr: *addr, data }.to_packet(*id)
+            }
             Self::Broadcast(p) => Some(p.clone()),
         }
     }

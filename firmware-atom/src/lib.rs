@@ -10,6 +10,8 @@
 
 mod atom;
 pub mod bus;
+pub mod cartesian;
+mod commands;
 pub mod config;
 pub mod driver;
 pub mod health;

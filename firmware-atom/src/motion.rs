@@ -134,7 +134,11 @@ mod tests {
         assert_eq!(speed(0), v_max);
         assert_eq!(speed(1), v_max / 2);
         assert_eq!(speed(4), v_max / 4);
-        assert_eq!(speed(2), 1, "a joint that stays put never gets speed 0 (= full speed)");
+        assert_eq!(
+            speed(2),
+            1,
+            "a joint that stays put never gets speed 0 (= full speed)"
+        );
         assert!(goals[3].is_none());
         // 1000 steps at 1706 steps/s plus one ramp.
         assert!((500_000..1_500_000).contains(&duration), "{duration}");

@@ -130,10 +130,7 @@ mod tests {
         );
         goals[1] = Some(goal_at(&cfg, 1, 13_900));
         assert!(check(&cfg, &limits, true, goals).is_ok());
-        assert_eq!(
-            check(&cfg, &limits, false, goals),
-            Err(Refusal::PoweredOff)
-        );
+        assert_eq!(check(&cfg, &limits, false, goals), Err(Refusal::PoweredOff));
     }
 
     #[test]

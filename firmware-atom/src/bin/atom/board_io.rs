@@ -15,6 +15,8 @@ use crate::leds::Leds;
 
 /// Widest PWM duty resolution used, in bits (the widest every LEDC version supports).
 const MAX_DUTY_BITS: u32 = 14;
+/// Protocol number of the button pin, readable like a user input (`firmware_atom::io`).
+const BUTTON_PIN: u8 = 39;
 /// LEDC low-speed timer clock (APB), in Hz.
 const LEDC_CLOCK_HZ: u32 = 80_000_000;
 
@@ -112,7 +114,7 @@ impl AtomIo for BoardIo<'_> {
     }
 
     fn read_pin(&mut self, pin: u8) -> Option<bool> {
-        if pin == firmware_atom::io::BUTTON_PIN {
+        if pin == BUTTON_PIN {
             return Some(self.button.is_high());
         }
         let (user, _) = self.user_pin(pin)?;

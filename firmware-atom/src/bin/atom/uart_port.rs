@@ -61,8 +61,7 @@ impl BytePort for UartPort<'_> {
         }
         let queued = u32::try_from(bytes.len() - rest.len()).unwrap_or(u32::MAX);
         // The UART shifts bytes out back to back at `baud`, after whatever was already queued.
-        self.tx_done_at_us =
-            self.tx_done_at_us.max(started_us) + wire_time_us(queued, self.baud);
+        self.tx_done_at_us = self.tx_done_at_us.max(started_us) + wire_time_us(queued, self.baud);
     }
 
     fn tx_idle(&self) -> bool {

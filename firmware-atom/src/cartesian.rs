@@ -1,0 +1,164 @@
+//! Coordinates: the kinematics model with the selected tool and world frames, and the
+//! conversions between the host protocol's 16-bit pose and the kinematics' 32-bit one.
+
+use kinematics_core::{IkError, JointAngles, Kinematics, Transform};
+use protocol_core::command::{EndType, MoveMode, Pose, ReferenceFrame};
+use protocol_core::units::{Centideg, DeciMm};
+
+use crate::config::{JOINTS, JointLimit};
+
+/// The kinematics with the frames the host selected (0x81..0x8A).
+#[derive(Clone, Debug)]
+pub struct Cartesian {
+    kin: Kinematics,
+    /// Tool pose in the flange frame (0x81).
+    pub tool: Pose,
+    /// Base pose in the world frame (0x83).
+    pub world: Pose,
+    /// Reference frame of reported and commanded coordinates (0x85).
+    pub reference: ReferenceFrame,
+    /// End type: flange or tool tip (0x89).
+    pub end: EndType,
+    /// Default interpolation of send coords without a mode byte (0x87).
+    pub movement: MoveMode,
+    /// FK of the last angles asked about, so repeated queries of an arm at rest cost nothing.
+    cache: Option<([Centideg; JOINTS], Pose)>,
+}
+
+impl Cartesian {
+    /// Flange in the base frame, joint interpolation, limits `limits`.
+    pub fn new(limits: &[JointLimit; JOINTS]) -> Self {
+        let mut c = Self {
+            kin: Kinematics::new(),
+            tool: Pose::default(),
+            world: Pose::default(),
+            reference: ReferenceFrame::Base,
+            end: EndType::Flange,
+            movement: MoveMode::Joint,
+            cache: None,
+        };
+        c.set_limits(limits);
+        c
+    }
+
+    /// Applies new joint limits to the IK's branch selection.
+    pub fn set_limits(&mut self, limits: &[JointLimit; JOINTS]) {
+        let mut l = kinematics_core::JointLimits::default();
+        for (j, lim) in limits.iter().enumerate() {
+            if let (Some(min), Some(max)) = (l.min.get_mut(j), l.max.get_mut(j)) {
+                *min = i32::from(lim.min.0);
+                *max = i32::from(lim.max.0);
+            }
+        }
+        self.kin.set_limits(l);
+    }
+
+    /// Re-applies the tool/world selection after one of the frame settings changed.
+    pub fn apply_frames(&mut self) {
+        let tool = (self.end == EndType::Tool).then(|| to_kin(&self.tool));
+        let world = (self.reference == ReferenceFrame::World).then(|| to_kin(&self.world));
+        self.kin.set_tool(tool);
+        self.kin.set_world(world);
+        self.cache = None;
+    }
+
+    /// The end pose at joint angles `angles`.
+    pub fn forward(&mut self, angles: &[Centideg; JOINTS]) -> Pose {
+        if let Some((a, p)) = &self.cache
+            && a == angles
+        {
+            return *p;
+        }
+        let pose = from_kin(&self.kin.forward(&joints(angles)));
+        self.cache = Some((*angles, pose));
+        pose
+    }
+
+    /// The joint angles that put the end at `pose`, on the branch nearest `seed`.
+    pub fn inverse(
+        &self,
+        pose: &Pose,
+        seed: &[Centideg; JOINTS],
+    ) -> Result<[Centideg; JOINTS], IkError> {
+        let q = self.kin.inverse(&to_kin(pose), &joints(seed))?;
+        Ok(angles(&q))
+    }
+
+    /// The pose `pose` rotated by `delta` about base axis `axis` (0 x, 1 y, 2 z), position kept.
+    pub fn rotate_about_base(&self, pose: &Pose, axis: usize, delta: Centideg) -> Pose {
+        let d = i32::from(delta.0);
+        let rot = kinematics_core::Pose {
+            rx: if axis == 0 { d } else { 0 },
+            ry: if axis == 1 { d } else { 0 },
+            rz: if axis == 2 { d } else { 0 },
+            ..Default::default()
+        };
+        let turned = Transform::from_pose(&rot).then(&Transform::from_pose(&to_kin(pose)));
+        let r = from_kin(&turned.to_pose());
+        Pose {
+            x: pose.x,
+            y: pose.y,
+            z: pose.z,
+            ..r
+        }
+    }
+
+    /// The kinematics model (for linear paths).
+    pub fn model(&self) -> &Kinematics {
+        &self.kin
+    }
+}
+
+/// Protocol joint angles as kinematics joint angles.
+pub fn joints(angles: &[Centideg; JOINTS]) -> JointAngles {
+    JointAngles(angles.map(|a| i32::from(a.0)))
+}
+
+/// Kinematics joint angles as protocol angles (saturated to +-327.67 deg).
+pub fn angles(q: &JointAngles) -> [Centideg; JOINTS] {
+    q.0.map(|v| Centideg(sat(v)))
+}
+
+/// A protocol pose as a kinematics pose.
+pub fn to_kin(p: &Pose) -> kinematics_core::Pose {
+    kinematics_core::Pose {
+        x: i32::from(p.x.0),
+        y: i32::from(p.y.0),
+        z: i32::from(p.z.0),
+        rx: i32::from(p.rx.0),
+        ry: i32::from(p.ry.0),
+        rz: i32::from(p.rz.0),
+    }
+}
+
+/// A kinematics pose as a protocol pose (each value saturated to int16).
+pub fn from_kin(p: &kinematics_core::Pose) -> Pose {
+    Pose {
+        x: DeciMm(sat(p.x)),
+        y: DeciMm(sat(p.y)),
+        z: DeciMm(sat(p.z)),
+        rx: Centideg(sat(p.rx)),
+        ry: Centideg(sat(p.ry)),
+        rz: Centideg(sat(p.rz)),
+    }
+}
+
+fn sat(v: i32) -> i16 {
+    v.clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::DEFAULT_LIMITS;
+
+    #[test]
+    fn zero_pose_matches_the_vendor_model() {
+        let mut c = Cartesian::new(&DEFAULT_LIMITS);
+        let p = c.forward(&[Centideg(0); JOINTS]);
+        // kinematics.md: flange at (45.6, -63.4, 412.67) mm, (-90, 0, -90) deg.
+        assert!((i32::from(p.x.0) - 456).abs() <= 1, "{p:?}");
+        assert!((i32::from(p.y.0) + 634).abs() <= 1, "{p:?}");
+        assert!((i32::from(p.z.0) - 4127).abs() <= 1, "{p:?}");
+    }
+}
