@@ -1,0 +1,149 @@
+//! The Basic board binary: binds [`firmware_basic::Basic`] to the chip and polls it forever.
+//!
+//! * UART0 at 115200: the host link (USB serial).
+//! * UART1 at 1 Mbaud: the shared bus (servos and the Atom).
+//! * GPIO: user outputs and inputs, front buttons; the speaker is held silent.
+//! * SPI: the ILI9342C LCD, showing the transponder's status one character per loop pass.
+//!
+//! Pins per chip are in [`pins`]; docs/boards.md says how to build and flash.
+#![no_std]
+#![no_main]
+#![deny(unsafe_code)]
+
+mod board_io;
+mod pins;
+mod screen;
+mod uart_port;
+
+use embedded_graphics::{pixelcolor::Rgb565, prelude::*};
+use embedded_hal::digital::OutputPin;
+use embedded_hal_bus::spi::ExclusiveDevice;
+use esp_hal::{
+    clock::CpuClock,
+    delay::Delay,
+    gpio::{Level, Output, OutputConfig},
+    main,
+    rtc_cntl::{Rtc, RwdtStage},
+    spi::{
+        Mode,
+        master::{Config as SpiConfig, Spi},
+    },
+    time::{Duration, Rate},
+    uart::Uart,
+};
+use firmware_basic::{Basic, BasicConfig};
+use mipidsi::{
+    Builder,
+    interface::SpiInterface,
+    models::ILI9342CRgb565,
+    options::{ColorInversion, ColorOrder},
+};
+use protocol_core::timing::{BUS_BAUD, HOST_BAUD};
+
+use crate::{
+    board_io::BoardIo,
+    screen::StatusScreen,
+    uart_port::{UartPort, now_us},
+};
+
+esp_bootloader_esp_idf::esp_app_desc!();
+
+/// The watchdog resets the chip if the loop stalls this long.
+const WATCHDOG_TIMEOUT_MS: u64 = 1_000;
+/// How often the loop feeds the watchdog (feeding is a slow RTC register write).
+const WATCHDOG_FEED_INTERVAL_US: u64 = 100_000;
+/// LCD SPI clock: the ILI9342C's write limit on the M5Stack Basic.
+const LCD_SPI_MHZ: u32 = 40;
+/// Bytes mipidsi batches per SPI write.
+const LCD_BUFFER_BYTES: usize = 512;
+
+/// Logs a line on UART0 with `log-uart0`; otherwise only type-checks its arguments.
+macro_rules! board_log {
+    ($($arg:tt)*) => {{
+        #[cfg(feature = "log-uart0")]
+        esp_println::println!($($arg)*);
+        #[cfg(not(feature = "log-uart0"))]
+        let _ = format_args!($($arg)*);
+    }};
+}
+
+#[main]
+fn main() -> ! {
+    let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
+    let mut pins = pins::take_pins!(p);
+    let _ = pins.speaker.set_low();
+    board_log!("open-mycobot basic {}", env!("CARGO_PKG_VERSION"));
+
+    let host_uart = Uart::new(p.UART0, uart_port::config(HOST_BAUD))
+        .unwrap_or_else(|_| panic!("host UART configuration refused"))
+        .with_tx(pins.host_tx)
+        .with_rx(pins.host_rx);
+    let mut host = UartPort::new(host_uart, HOST_BAUD);
+    let bus_uart = Uart::new(p.UART1, uart_port::config(BUS_BAUD))
+        .unwrap_or_else(|_| panic!("bus UART configuration refused"))
+        .with_tx(pins.bus_tx)
+        .with_rx(pins.bus_rx);
+    let mut bus = UartPort::new(bus_uart, BUS_BAUD);
+    let mut io = BoardIo::new(pins.outputs, pins.inputs, pins.buttons);
+
+    // The LCD is a nicety: without it (driver refused, panel absent) the transponder runs on.
+    let mut lcd_buffer = [0_u8; LCD_BUFFER_BYTES];
+    let spi_config = SpiConfig::default()
+        .with_frequency(Rate::from_mhz(LCD_SPI_MHZ))
+        .with_mode(Mode::_0);
+    let display = Spi::new(p.SPI2, spi_config).ok().and_then(|spi| {
+        let spi = spi.with_sck(pins.lcd_clk).with_mosi(pins.lcd_mosi);
+        let cs = Output::new(pins.lcd_cs, Level::High, OutputConfig::default());
+        let dc = Output::new(pins.lcd_dc, Level::Low, OutputConfig::default());
+        let device = ExclusiveDevice::new(spi, cs, Delay::new()).ok()?;
+        Builder::new(
+            ILI9342CRgb565,
+            SpiInterface::new(device, dc, &mut lcd_buffer),
+        )
+        .reset_pin(pins.lcd_reset)
+        .color_order(ColorOrder::Bgr)
+        .invert_colors(ColorInversion::Inverted)
+        .init(&mut Delay::new())
+        .ok()
+    });
+    let mut screen = display.and_then(|mut display| {
+        display.clear(Rgb565::BLACK).ok()?;
+        let _ = pins.lcd_backlight.set_high();
+        Some(StatusScreen::new(display))
+    });
+    if screen.is_none() {
+        board_log!("LCD did not initialise; running without a status screen");
+    }
+
+    let mut basic = Basic::new(BasicConfig::default());
+
+    let mut rtc = Rtc::new(p.RTC_TIMER);
+    rtc.rwdt.set_timeout(
+        RwdtStage::Stage0,
+        Duration::from_millis(WATCHDOG_TIMEOUT_MS),
+    );
+    rtc.rwdt.enable();
+    let mut fed_at_us = now_us();
+
+    loop {
+        let now = now_us();
+        basic.poll(now, &mut host, &mut bus, &mut io);
+        if let Some(screen) = &mut screen {
+            screen.update(now, basic.status());
+            screen.draw_next();
+        }
+        if now.wrapping_sub(fed_at_us) >= WATCHDOG_FEED_INTERVAL_US {
+            rtc.rwdt.feed();
+            fed_at_us = now;
+        }
+    }
+}
+
+/// Nothing reachable from received bytes panics (the libraries are tested for it); a panic
+/// here is a firmware bug, and a restart is the quickest way back to a working transponder.
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    board_log!("panic: {}", info);
+    let _ = info;
+    esp_hal::system::software_reset()
+}
