@@ -100,18 +100,19 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
 
     /// Runs until `stop` is set (by a signal handler), then returns the robot.
     pub fn run(mut self, stop: &AtomicBool) -> io::Result<R> {
-        let wall_start = Instant::now();
-        let mut virtual_at_start = self.robot.now_us();
+        // Virtual time = virtual_at_sync + wall time since wall_sync.
+        let mut wall_sync = Instant::now();
+        let mut virtual_at_sync = self.robot.now_us();
         let mut input = [0u8; 4096];
         let mut output = Vec::with_capacity(256);
         while !stop.load(Ordering::Relaxed) {
             self.wait_for_input()?;
 
-            let mut target_us = virtual_at_start + micros(wall_start.elapsed());
-            let behind_us = target_us.saturating_sub(self.robot.now_us());
-            if behind_us > micros(MAX_CATCH_UP) {
-                virtual_at_start -= behind_us - micros(MAX_CATCH_UP);
-                target_us = virtual_at_start + micros(wall_start.elapsed());
+            let mut target_us = virtual_at_sync.saturating_add(micros(wall_sync.elapsed()));
+            if target_us > self.robot.now_us() + micros(MAX_CATCH_UP) {
+                target_us = self.robot.now_us() + micros(MAX_CATCH_UP);
+                wall_sync = Instant::now();
+                virtual_at_sync = target_us;
             }
             self.robot.run_until(target_us);
 
@@ -264,5 +265,49 @@ mod tests {
             virtual_end_us > 1_000,
             "virtual time followed the wall clock"
         );
+    }
+
+    /// Stalls 150 ms (a machine under load) on its second advance; records every advance.
+    struct StallingRobot {
+        now_us: u64,
+        advances_us: Vec<u64>,
+        stop: Arc<AtomicBool>,
+    }
+
+    impl RealtimeRobot for StallingRobot {
+        fn now_us(&self) -> u64 {
+            self.now_us
+        }
+        fn host_write(&mut self, _: &[u8]) {}
+        fn host_read(&mut self, _: &mut Vec<u8>) {}
+        fn run_until(&mut self, t_us: u64) {
+            assert!(t_us >= self.now_us, "time went backwards");
+            self.advances_us.push(t_us - self.now_us);
+            self.now_us = t_us;
+            if self.advances_us.len() == 2 {
+                std::thread::sleep(Duration::from_millis(150));
+            }
+            if self.advances_us.len() == 50 {
+                self.stop.store(true, Ordering::Relaxed);
+            }
+        }
+    }
+
+    #[test]
+    fn after_a_stall_the_arm_does_not_jump_ahead_by_more_than_the_catch_up_limit() {
+        let stop = Arc::new(AtomicBool::new(false));
+        let robot = StallingRobot {
+            now_us: 0,
+            advances_us: Vec::new(),
+            stop: Arc::clone(&stop),
+        };
+        let driver = RealtimeDriver::new(robot, PseudoTerminal::open().unwrap(), None);
+        let robot = driver.run(&stop).unwrap();
+        let largest = robot.advances_us.iter().max().copied().unwrap();
+        assert!(
+            largest <= micros(MAX_CATCH_UP),
+            "advanced {largest} us at once"
+        );
+        assert_eq!(robot.advances_us.len(), 50);
     }
 }
