@@ -115,6 +115,11 @@ impl Forwarder {
         self.echo_heard
     }
 
+    /// Records whether the wiring echoes, learned elsewhere (transparent mode).
+    pub(crate) fn set_echo_heard(&mut self, heard: bool) {
+        self.echo_heard = Some(heard);
+    }
+
     /// True while a request is in flight or queued.
     pub(crate) fn busy(&self) -> bool {
         self.current.is_some() || !self.queue.is_empty()
@@ -154,26 +159,23 @@ impl Forwarder {
             },
             ..
         }) = &mut self.current
+            && !*collided
         {
-            if !*collided {
-                if config.echo != EchoMode::Absent && wire.get(*echoed) == Some(&byte) {
-                    *echoed += 1;
-                    if *echoed == wire.len() {
-                        self.echo_heard = Some(true);
-                        self.start_waiting(now_us, config);
-                    }
-                    return;
+            if config.echo != EchoMode::Absent && wire.get(*echoed) == Some(&byte) {
+                *echoed += 1;
+                if *echoed == wire.len() {
+                    self.echo_heard = Some(true);
+                    self.start_waiting(now_us, config);
                 }
-                *collided = true;
+                return;
             }
+            // Not our echo: somebody else talked while we did.
+            *collided = true;
         }
-        let mut frames: Vec<Frame, 2> = Vec::new();
-        self.decoder.feed(&[byte], |frame| {
-            // A byte completes at most one frame plus whatever its rescan uncovers; keep two.
-            let _ = frames.push(frame);
-        });
-        for frame in frames {
+        let mut next = self.decoder.push(byte);
+        while let Some(frame) = next {
             self.on_frame(frame, &mut on_event);
+            next = self.decoder.next_frame();
         }
     }
 

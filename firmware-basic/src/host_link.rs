@@ -44,20 +44,24 @@ impl HostLink {
         now_us.saturating_sub(self.last_rx_us)
     }
 
-    /// Frames one host byte; calls `on_frame` with each frame it completes.
-    pub(crate) fn frame_byte(&mut self, byte: u8, on_frame: impl FnMut(Frame)) {
-        self.decoder.feed(&[byte], on_frame);
+    /// Frames one host byte; returns the frame it completes (drain [`Self::next_frame`]).
+    pub(crate) fn push(&mut self, byte: u8) -> Option<Frame> {
+        self.decoder.push(byte)
+    }
+
+    /// The next frame already complete in the framer.
+    pub(crate) fn next_frame(&mut self) -> Option<Frame> {
+        self.decoder.next_frame()
     }
 
     /// Drops a partial frame once the host has been quiet for [`timing::HOST_FRAME_GAP_US`]
-    /// (it was cut short); calls `on_frame` with any real frame uncovered by the rescan.
-    pub(crate) fn check_gap(&mut self, now_us: u64, mut on_frame: impl FnMut(Frame)) {
+    /// (it was cut short); returns a real frame uncovered by the rescan, if any (drain
+    /// [`Self::next_frame`]).
+    pub(crate) fn check_gap(&mut self, now_us: u64) -> Option<Frame> {
         if self.decoder.has_partial() && self.quiet_for_us(now_us) >= timing::HOST_FRAME_GAP_US {
-            let mut next = self.decoder.on_quiet_line();
-            while let Some(frame) = next {
-                on_frame(frame);
-                next = self.decoder.next_frame();
-            }
+            self.decoder.on_quiet_line()
+        } else {
+            None
         }
     }
 

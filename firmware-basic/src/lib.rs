@@ -23,50 +23,34 @@ pub mod host_link;
 pub mod io;
 pub mod local;
 pub mod status;
+mod supervisor;
 pub mod transparent;
 
 pub use config::{BasicConfig, EchoMode};
 pub use io::{BasicIo, Buttons, NullIo};
 pub use status::{AtomLink, BasicError, BasicStatus, TransponderMode};
 
-use forwarder::{Event, Forwarder, Origin, Request};
+use forwarder::{Forwarder, Origin, Request};
 use host_link::{HOST_READ_BUDGET, HostLink};
 use protocol_core::{BytePort, Frame};
+use supervisor::Supervisor;
 use transparent::Transparent;
 
 /// Most bus bytes taken per poll: a poll stays short, and 256 bytes is 2.5 ms of bus time,
 /// far more than arrives between two polls of a board's loop.
 pub const BUS_READ_BUDGET: usize = 256;
 
-/// Atom command codes the transponder itself uses or watches.
-mod atom_cmd {
-    /// Power on: torque on, servos ready.
-    pub const POWER_ON: u8 = 0x10;
-    /// Power off.
-    pub const POWER_OFF: u8 = 0x11;
-    /// Is powered on: 1 byte.
-    pub const IS_POWERED_ON: u8 = 0x12;
-    /// Release all servos.
-    pub const RELEASE_ALL_SERVOS: u8 = 0x13;
-}
-
 /// The Basic's transponder: one per board, polled forever.
 #[derive(Debug)]
 pub struct Basic {
     config: BasicConfig,
-    status: BasicStatus,
+    mode: TransponderMode,
     host: HostLink,
     forwarder: Forwarder,
     transparent: Transparent,
+    supervisor: Supervisor,
     /// The first poll (the Basic's boot) has happened.
     booted: bool,
-    /// The boot power-on (0x10) has not been answered yet.
-    power_on_pending: bool,
-    /// Earliest time of the next internal request.
-    next_internal_us: u64,
-    /// When the Atom last answered anything.
-    last_answer_us: u64,
-    buttons: Buttons,
 }
 
 impl Basic {
@@ -74,18 +58,12 @@ impl Basic {
     pub fn new(config: BasicConfig) -> Self {
         Self {
             config,
-            status: BasicStatus {
-                version_x10: config.version_x10,
-                ..BasicStatus::default()
-            },
+            mode: TransponderMode::Framed,
             host: HostLink::new(),
             forwarder: Forwarder::new(),
             transparent: Transparent::default(),
+            supervisor: Supervisor::new(&config),
             booted: false,
-            power_on_pending: config.power_on_at_boot,
-            next_internal_us: 0,
-            last_answer_us: 0,
-            buttons: Buttons::default(),
         }
     }
 
@@ -103,26 +81,33 @@ impl Basic {
             self.booted = true;
             // Whatever the wire was doing before we booted, give it a quiet time first.
             self.forwarder.note_activity(now_us);
-            self.last_answer_us = now_us;
-            self.next_internal_us = now_us.saturating_add(self.config.boot_power_on_delay_us);
+            self.supervisor.boot(now_us, &self.config);
         }
         self.read_bus(now_us, bus);
         self.read_host(now_us, host, io);
-        match self.status.mode {
+        match self.mode {
             TransponderMode::Framed => {
-                self.schedule_internal(now_us, io);
-                let mut events: heapless::Vec<Event, 4> = heapless::Vec::new();
-                self.forwarder.poll(now_us, bus, &self.config, |e| {
-                    let _ = events.push(e);
-                });
-                for event in events {
-                    self.on_event(now_us, event);
+                let idle = !self.forwarder.busy();
+                if let Some(request) =
+                    self.supervisor
+                        .next_internal(now_us, &self.config, io.buttons(), idle)
+                {
+                    // Cannot fail: the queue is empty.
+                    let _ = self.forwarder.enqueue(request);
                 }
+                let (supervisor, link) = (&mut self.supervisor, &mut self.host);
+                self.forwarder.poll(now_us, bus, &self.config, |e| {
+                    supervisor.on_event(now_us, e, link)
+                });
             }
             TransponderMode::Transparent => {
                 let quiet_us = self.forwarder.quiet_for_us(now_us);
                 let echo = self.echo_expected();
-                self.transparent.poll(now_us, quiet_us, bus, echo);
+                let (supervisor, link) = (&mut self.supervisor, &mut self.host);
+                let learned = self.transparent.poll(now_us, quiet_us, bus, echo, |b| {
+                    send_raw(link, supervisor, b)
+                });
+                self.learn_echo(learned);
             }
         }
         self.host.flush(host);
@@ -131,17 +116,29 @@ impl Basic {
     /// What the LCD shows.
     pub fn status(&self) -> BasicStatus {
         BasicStatus {
+            mode: self.mode,
             echo_heard: self.forwarder.echo_heard(),
-            ..self.status
+            transparent_dropped: self.transparent.dropped,
+            ..self.supervisor.status
         }
     }
 
-    /// Whether the Basic should expect its own bytes back from the bus.
-    fn echo_expected(&self) -> bool {
+    /// Whether the Basic hears its own bytes on the bus, if known.
+    fn echo_expected(&self) -> Option<bool> {
         match self.config.echo {
-            EchoMode::Present => true,
-            EchoMode::Absent => false,
-            EchoMode::Auto => self.forwarder.echo_heard() == Some(true),
+            EchoMode::Present => Some(true),
+            EchoMode::Absent => Some(false),
+            EchoMode::Auto => self.forwarder.echo_heard(),
+        }
+    }
+
+    /// Records what a transparent-mode write showed about the echo, while it is unknown.
+    fn learn_echo(&mut self, learned: Option<bool>) {
+        if let Some(heard) = learned
+            && self.config.echo == EchoMode::Auto
+            && self.forwarder.echo_heard().is_none()
+        {
+            self.forwarder.set_echo_heard(heard);
         }
     }
 
@@ -150,23 +147,19 @@ impl Basic {
             let Some(byte) = bus.read_byte() else {
                 break;
             };
-            match self.status.mode {
+            let (supervisor, link) = (&mut self.supervisor, &mut self.host);
+            match self.mode {
                 TransponderMode::Framed => {
-                    let mut events: heapless::Vec<Event, 2> = heapless::Vec::new();
                     self.forwarder.on_bus_byte(now_us, byte, &self.config, |e| {
-                        let _ = events.push(e);
+                        supervisor.on_event(now_us, e, link)
                     });
-                    for event in events {
-                        self.on_event(now_us, event);
-                    }
                 }
                 TransponderMode::Transparent => {
                     self.forwarder.note_activity(now_us);
-                    if let Some(b) = self.transparent.bus_byte(byte)
-                        && !self.host.send_bytes(&[b])
-                    {
-                        self.status.last_error = Some(BasicError::HostOverflow);
-                    }
+                    let learned = self
+                        .transparent
+                        .bus_byte(byte, |b| send_raw(link, supervisor, b));
+                    self.learn_echo(learned);
                 }
             }
         }
@@ -177,14 +170,12 @@ impl Basic {
             let Some(byte) = self.host.read_byte(now_us, host) else {
                 break;
             };
-            match self.status.mode {
+            match self.mode {
                 TransponderMode::Framed => {
-                    let mut frames: heapless::Vec<Frame, 2> = heapless::Vec::new();
-                    self.host.frame_byte(byte, |f| {
-                        let _ = frames.push(f);
-                    });
-                    for frame in frames {
-                        self.on_host_frame(now_us, frame, io);
+                    let mut next = self.host.push(byte);
+                    while let Some(frame) = next {
+                        self.on_host_frame(frame, io);
+                        next = self.host.next_frame();
                     }
                 }
                 TransponderMode::Transparent => {
@@ -194,25 +185,24 @@ impl Basic {
                 }
             }
         }
-        let quiet_us = self.host.quiet_for_us(now_us);
-        match self.status.mode {
+        match self.mode {
             TransponderMode::Framed => {
-                let mut frames: heapless::Vec<Frame, 2> = heapless::Vec::new();
-                self.host.check_gap(now_us, |f| {
-                    let _ = frames.push(f);
-                });
-                for frame in frames {
-                    self.on_host_frame(now_us, frame, io);
+                let mut next = self.host.check_gap(now_us);
+                while let Some(frame) = next {
+                    self.on_host_frame(frame, io);
+                    next = self.host.next_frame();
                 }
             }
-            TransponderMode::Transparent => self.transparent.host_quiet(quiet_us),
+            TransponderMode::Transparent => {
+                self.transparent.host_quiet(self.host.quiet_for_us(now_us));
+            }
         }
     }
 
-    fn on_host_frame<I: BasicIo>(&mut self, _now_us: u64, frame: Frame, io: &mut I) {
-        self.status.host_frames = self.status.host_frames.wrapping_add(1);
-        if self.status.mode == TransponderMode::Transparent {
-            // A second frame completed by the same byte after an exit: forward it raw.
+    fn on_host_frame<I: BasicIo>(&mut self, frame: Frame, io: &mut I) {
+        if self.mode == TransponderMode::Transparent {
+            // A frame completed by the same byte as the one that entered transparent mode:
+            // it is raw data now.
             for &b in frame.to_bytes().iter() {
                 if self.transparent.host_byte(b) {
                     self.leave_transparent();
@@ -220,122 +210,55 @@ impl Basic {
             }
             return;
         }
-        if let Some(answer) = local::answer(&frame, io, self.config.version_x10, self.status.mode) {
+        let cmd = frame.cmd();
+        self.supervisor.on_host_request(cmd);
+        if let Some(answer) = local::answer(&frame, io, self.config.version_x10, self.mode) {
             let sent = match &answer.reply {
                 local::Reply::Frame(reply) => self.host.send_frame(reply),
                 local::Reply::Raw(bytes) => self.host.send_bytes(bytes),
             };
             if !sent {
-                self.status.last_error = Some(BasicError::HostOverflow);
+                self.supervisor.error(BasicError::HostOverflow);
             }
             if let Some(error) = answer.error {
-                self.status.last_error = Some(error);
+                self.supervisor.error(error);
             }
             if answer.new_mode == Some(TransponderMode::Transparent) {
                 self.enter_transparent();
             }
             return;
         }
-        let cmd = frame.cmd();
-        if matches!(cmd, atom_cmd::POWER_OFF | atom_cmd::RELEASE_ALL_SERVOS) {
-            // The host has taken charge of the arm's power: do not power it on behind its back.
-            self.power_on_pending = false;
-        }
         let request = Request {
             frame,
             origin: Origin::Host,
         };
         if self.forwarder.enqueue(request).is_err() {
-            self.status.last_error = Some(BasicError::QueueFull { cmd });
+            self.supervisor.error(BasicError::QueueFull { cmd });
         }
     }
 
     fn enter_transparent(&mut self) {
-        self.status.mode = TransponderMode::Transparent;
+        self.mode = TransponderMode::Transparent;
         self.forwarder.clear();
         self.host.reset_framer();
         self.transparent = Transparent::default();
     }
 
     fn leave_transparent(&mut self) {
-        self.status.mode = TransponderMode::Framed;
+        self.mode = TransponderMode::Framed;
         self.host.reset_framer();
         self.transparent = Transparent::default();
         // Cannot fail to build: one data byte.
         let ack = Frame::new(local::code::SET_TRANSPONDER_MODE, &[1]).unwrap_or_default();
         if !self.host.send_frame(&ack) {
-            self.status.last_error = Some(BasicError::HostOverflow);
+            self.supervisor.error(BasicError::HostOverflow);
         }
     }
+}
 
-    /// Powers the Atom on after boot and probes it when it has been silent for a while.
-    fn schedule_internal<I: BasicIo>(&mut self, now_us: u64, io: &mut I) {
-        let buttons = io.buttons();
-        if buttons.a && !self.buttons.a {
-            self.power_on_pending = true;
-            self.next_internal_us = now_us;
-        }
-        self.buttons = buttons;
-        if self.forwarder.busy() || now_us < self.next_internal_us {
-            return;
-        }
-        let interval_us = self.config.probe_interval_us;
-        let (cmd, origin) = if self.power_on_pending {
-            (atom_cmd::POWER_ON, Origin::PowerOn)
-        } else if interval_us > 0 && now_us.saturating_sub(self.last_answer_us) >= interval_us {
-            (atom_cmd::IS_POWERED_ON, Origin::Probe)
-        } else {
-            return;
-        };
-        if interval_us == 0 && origin == Origin::PowerOn {
-            // Without probing, the power-on is tried once.
-            self.power_on_pending = false;
-        }
-        self.next_internal_us = now_us.saturating_add(interval_us.max(1));
-        // Cannot fail: no data; the queue is empty (not busy).
-        let frame = Frame::new(cmd, &[]).unwrap_or_default();
-        let _ = self.forwarder.enqueue(Request { frame, origin });
-    }
-
-    fn on_event(&mut self, now_us: u64, event: Event) {
-        let status = &mut self.status;
-        match event {
-            Event::Reply { request, reply } => {
-                status.atom = AtomLink::Answering;
-                self.last_answer_us = now_us;
-                let done = reply.data() == [1];
-                match (request.frame.cmd(), reply.data()) {
-                    (atom_cmd::POWER_ON, _) if done => {
-                        status.atom_powered = Some(true);
-                        self.power_on_pending = false;
-                    }
-                    (atom_cmd::POWER_OFF, _) if done => status.atom_powered = Some(false),
-                    (atom_cmd::IS_POWERED_ON, &[state]) => status.atom_powered = Some(state == 1),
-                    _ => {}
-                }
-                if request.origin == Origin::Host {
-                    if self.host.send_frame(&reply) {
-                        status.replies_forwarded = status.replies_forwarded.wrapping_add(1);
-                    } else {
-                        status.last_error = Some(BasicError::HostOverflow);
-                    }
-                }
-            }
-            Event::Timeout(request) => {
-                status.atom = AtomLink::Silent;
-                status.timeouts = status.timeouts.wrapping_add(1);
-                status.last_error = Some(BasicError::ReplyTimeout {
-                    cmd: request.frame.cmd(),
-                });
-            }
-            Event::GaveUp(request) => {
-                status.collisions = status.collisions.wrapping_add(1);
-                status.last_error = Some(BasicError::BusCollisions {
-                    cmd: request.frame.cmd(),
-                });
-            }
-            Event::Collision => status.collisions = status.collisions.wrapping_add(1),
-            Event::Unsolicited => {}
-        }
+/// Queues one raw byte for the host, noting an overflow.
+fn send_raw(host: &mut HostLink, supervisor: &mut Supervisor, byte: u8) {
+    if !host.send_bytes(&[byte]) {
+        supervisor.error(BasicError::HostOverflow);
     }
 }

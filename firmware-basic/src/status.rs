@@ -86,7 +86,7 @@ pub struct BasicStatus {
     pub echo_heard: Option<bool>,
     /// The last thing that went wrong.
     pub last_error: Option<BasicError>,
-    /// Host frames received (own and forwarded). Wraps.
+    /// Host frames received in framed mode (own commands and forwarded). Wraps.
     pub host_frames: u32,
     /// Replies from the Atom passed to the host. Wraps.
     pub replies_forwarded: u32,
@@ -94,4 +94,6 @@ pub struct BasicStatus {
     pub timeouts: u32,
     /// Bus transmissions that collided and were repeated. Wraps.
     pub collisions: u32,
+    /// Host bytes dropped in transparent mode because the bus could not take them. Wraps.
+    pub transparent_dropped: u32,
 }

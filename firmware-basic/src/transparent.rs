@@ -27,9 +27,11 @@ pub(crate) struct Transparent {
     /// Host bytes that match the start of [`EXIT_FRAME`] so far.
     held: Vec<u8, 6>,
     to_bus: Deque<u8, TO_BUS_CAPACITY>,
-    /// Bytes written to the bus whose echo has not come back yet.
-    echo: Deque<u8, BUS_WRITE_CHUNK>,
-    /// When the last write left the transmitter; echo still expected until the grace is over.
+    /// The last write to the bus while its echo may still come back...
+    sent: Vec<u8, BUS_WRITE_CHUNK>,
+    /// ...and how many of its bytes have come back so far (held until the echo is complete).
+    echoed: usize,
+    /// When the last write left the transmitter.
     tx_done_us: Option<u64>,
     /// Host bytes dropped because the bus queue was full. Wraps.
     pub(crate) dropped: u32,
@@ -72,58 +74,78 @@ impl Transparent {
         }
     }
 
-    /// Takes one byte from the bus; returns it unless it is the echo of our own transmission.
-    pub(crate) fn bus_byte(&mut self, byte: u8) -> Option<u8> {
-        match self.echo.front() {
-            Some(&expected) if expected == byte => {
-                self.echo.pop_front();
-                None
+    /// Takes one byte from the bus and passes what is not our own echo to `emit`. An echo is
+    /// recognised only whole: bytes that match the start of our last write are held until the
+    /// rest matches too, and released if it does not. Returns `Some(true)` when a whole echo
+    /// came back.
+    pub(crate) fn bus_byte(&mut self, byte: u8, mut emit: impl FnMut(u8)) -> Option<bool> {
+        if self.sent.get(self.echoed) == Some(&byte) {
+            self.echoed += 1;
+            if self.echoed == self.sent.len() {
+                self.sent.clear();
+                self.echoed = 0;
+                return Some(true);
             }
-            Some(_) => {
-                // Not our echo: a collision or a station answering; stop expecting it.
-                self.echo.clear();
-                Some(byte)
-            }
-            None => Some(byte),
+            return None;
         }
+        self.release_echo(&mut emit);
+        emit(byte);
+        None
+    }
+
+    /// Passes bytes held as a possible echo on to `emit`: they were not one.
+    fn release_echo(&mut self, emit: &mut impl FnMut(u8)) {
+        for &b in self.sent.get(..self.echoed).unwrap_or(&[]) {
+            emit(b);
+        }
+        self.sent.clear();
+        self.echoed = 0;
     }
 
     /// Writes queued host bytes onto the bus when the wire has been quiet for
-    /// [`timing::BUS_QUIET_BEFORE_SEND_US`]. `echo` says whether the wiring echoes.
+    /// [`timing::BUS_QUIET_BEFORE_SEND_US`]. `echo` is whether the wiring echoes, if known.
+    /// Returns `Some(false)` when a write came back silent (no echo on this wiring).
     pub(crate) fn poll<B: BytePort>(
         &mut self,
         now_us: u64,
         bus_quiet_us: u64,
         bus: &mut B,
-        echo: bool,
-    ) {
+        echo: Option<bool>,
+        mut emit: impl FnMut(u8),
+    ) -> Option<bool> {
         if !bus.tx_idle() {
-            return;
+            return None;
         }
+        let mut learned = None;
         let done = *self.tx_done_us.get_or_insert(now_us);
-        if now_us.saturating_sub(done) >= ECHO_GRACE_US {
-            self.echo.clear();
+        if !self.sent.is_empty() && now_us.saturating_sub(done) >= ECHO_GRACE_US {
+            if self.echoed == 0 {
+                learned = Some(false);
+            }
+            self.release_echo(&mut emit);
         }
         if self.to_bus.is_empty()
-            || !self.echo.is_empty()
+            || !self.sent.is_empty()
             || bus_quiet_us < timing::BUS_QUIET_BEFORE_SEND_US
         {
-            return;
+            return learned;
         }
         let mut chunk: Vec<u8, BUS_WRITE_CHUNK> = Vec::new();
         while !chunk.is_full() {
             match self.to_bus.pop_front() {
+                // Cannot fail: the chunk is not full.
                 Some(b) => {
                     let _ = chunk.push(b);
-                    if echo {
-                        let _ = self.echo.push_back(b);
-                    }
                 }
                 None => break,
             }
         }
         bus.write(&chunk);
+        if echo != Some(false) {
+            self.sent = chunk;
+        }
         self.tx_done_us = None;
+        learned
     }
 }
 
@@ -160,8 +182,8 @@ mod tests {
     fn exit_frame_after_an_extra_header_byte_still_exits() {
         let mut t = Transparent::default();
         assert!(!t.host_byte(0xFE));
-        let exited = EXIT_FRAME.iter().map(|&b| t.host_byte(b)).any(|e| e);
-        assert!(exited);
+        let exits: std::vec::Vec<bool> = EXIT_FRAME.iter().map(|&b| t.host_byte(b)).collect();
+        assert_eq!(exits.last(), Some(&true));
         assert_eq!(drain(&mut t), [0xFE]);
     }
 
@@ -176,17 +198,48 @@ mod tests {
         assert_eq!(drain(&mut t), [0xFE, 0xFE]);
     }
 
-    #[test]
-    fn own_echo_is_removed_but_other_bytes_pass() {
-        let mut t = Transparent::default();
+    fn from_bus(t: &mut Transparent, bytes: &[u8]) -> (std::vec::Vec<u8>, Option<bool>) {
+        let mut out = std::vec::Vec::new();
+        let mut learned = None;
+        for &b in bytes {
+            learned = learned.or(t.bus_byte(b, |x| out.push(x)));
+        }
+        (out, learned)
+    }
+
+    fn write_123(t: &mut Transparent, echo: Option<bool>) {
         for b in [1, 2, 3] {
             t.host_byte(b);
         }
         let mut bus = protocol_core::NullPort;
-        t.poll(1_000, 1_000, &mut bus, true);
-        assert_eq!(t.bus_byte(1), None);
-        assert_eq!(t.bus_byte(2), None);
-        assert_eq!(t.bus_byte(9), Some(9));
-        assert_eq!(t.bus_byte(3), Some(3));
+        t.poll(1_000, 1_000, &mut bus, echo, |_| {});
+    }
+
+    #[test]
+    fn a_whole_echo_is_removed() {
+        let mut t = Transparent::default();
+        write_123(&mut t, None);
+        assert_eq!(from_bus(&mut t, &[1, 2, 3, 4]), (std::vec![4], Some(true)));
+    }
+
+    #[test]
+    fn a_reply_that_starts_like_the_request_is_not_taken_for_an_echo() {
+        let mut t = Transparent::default();
+        write_123(&mut t, None);
+        assert_eq!(from_bus(&mut t, &[1, 2, 9]), (std::vec![1, 2, 9], None));
+    }
+
+    #[test]
+    fn a_silent_write_means_no_echo_and_releases_nothing() {
+        let mut t = Transparent::default();
+        write_123(&mut t, None);
+        let mut bus = protocol_core::NullPort;
+        let mut out = std::vec::Vec::new();
+        t.poll(1_000, 1_000, &mut bus, None, |b| out.push(b));
+        let learned = t.poll(1_000 + ECHO_GRACE_US, 1_000, &mut bus, None, |b| {
+            out.push(b)
+        });
+        assert_eq!(learned, Some(false));
+        assert!(out.is_empty());
     }
 }

@@ -3,15 +3,23 @@
 
 mod common;
 
-use common::{Rig, frame};
-use firmware_basic::{AtomLink, BasicError};
-use protocol_core::{Frame, timing};
+use common::{BUS_BYTE_NS, Rig, frame};
+use firmware_basic::{AtomLink, BasicConfig, BasicError, EchoMode};
+use protocol_core::Frame;
 
 const GET_ANGLES: u8 = 0x20;
+const IS_POWERED_ON: u8 = 0x12;
+const SEND_ANGLES: u8 = 0x22;
 
 fn angles_reply() -> Vec<u8> {
-    frame(GET_ANGLES, &[0, 100, 0xFF, 0x9C, 0, 0, 0, 0, 0x12, 0x34, 0xFE, 0xFA])
+    frame(
+        GET_ANGLES,
+        &[0, 100, 0xFF, 0x9C, 0, 0, 0, 0, 0x12, 0x34, 0xFE, 0xFA],
+    )
 }
+
+/// A servo status packet (present position of servo 3), as the Atom's polling puts on the wire.
+const SERVO_PACKET: [u8; 8] = [0xFF, 0xFF, 0x03, 0x04, 0x00, 0x00, 0x08, 0xF0];
 
 #[test]
 fn get_angles_goes_to_the_atom_once_and_its_reply_to_the_host_once() {
@@ -26,4 +34,272 @@ fn get_angles_goes_to_the_atom_once_and_its_reply_to_the_host_once() {
         assert_eq!(rig.basic.status().atom, AtomLink::Answering);
         assert_eq!(rig.basic.status().echo_heard, Some(echo));
     }
+}
+
+#[test]
+fn works_with_the_echo_mode_fixed_by_config() {
+    for (echo, mode) in [(true, EchoMode::Present), (false, EchoMode::Absent)] {
+        let config = BasicConfig {
+            echo: mode,
+            power_on_at_boot: false,
+            probe_interval_us: 0,
+            ..BasicConfig::default()
+        };
+        let mut rig = Rig::new(config, echo);
+        for _ in 0..3 {
+            rig.host.send(&frame(GET_ANGLES, &[]));
+            rig.run_us(5_000);
+        }
+        assert_eq!(rig.atom_got.len(), 3, "{mode:?}");
+        assert_eq!(rig.host_frames().len(), 3, "{mode:?}");
+        assert_eq!(rig.basic.status().collisions, 0);
+    }
+}
+
+#[test]
+fn a_request_arriving_in_pieces_is_forwarded_whole() {
+    let mut rig = Rig::quiet(true);
+    let request = frame(
+        SEND_ANGLES,
+        &[0, 0, 0xFE, 0xFE, 0, 0, 0, 0, 0xFA, 0, 0, 0, 50],
+    );
+    for chunk in request.chunks(4) {
+        rig.host.send(chunk);
+        // A USB-serial adapter delivers in bursts; 1 ms apart is within a frame's gap.
+        rig.run_us(1_000);
+    }
+    rig.run_us(5_000);
+    assert_eq!(rig.atom_got.len(), 1);
+    assert_eq!(rig.atom_got[0].1.to_bytes().as_slice(), request.as_slice());
+    assert_eq!(rig.host.received(), frame(SEND_ANGLES, &[1]));
+}
+
+#[test]
+fn a_truncated_request_is_dropped_and_does_not_swallow_the_next() {
+    let mut rig = Rig::quiet(true);
+    // The first 6 bytes of a send_angles, then the sender resets.
+    rig.host.send(&[0xFE, 0xFE, 0x0F, SEND_ANGLES, 0x01, 0x02]);
+    rig.run_us(3_000);
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(5_000);
+    let got: Vec<u8> = rig.atom_got.iter().map(|(_, f)| f.cmd()).collect();
+    assert_eq!(got, [GET_ANGLES]);
+    assert_eq!(rig.host.received(), angles_reply());
+}
+
+#[test]
+fn servo_packets_garbage_and_other_frames_never_reach_the_host() {
+    let mut rig = Rig::quiet(true);
+    rig.atom = Box::new(|f: &Frame| {
+        // Servo traffic, a frame for another command, noise, then the reply and a duplicate.
+        let mut bytes = SERVO_PACKET.to_vec();
+        bytes.extend(frame(0x2B, &[0]));
+        bytes.extend([0xFE, 0x00, 0xFA, 0xFE, 0xFE]);
+        bytes.extend(frame(f.cmd(), &[1]));
+        bytes.extend(SERVO_PACKET);
+        bytes.extend(frame(f.cmd(), &[1]));
+        Some(bytes)
+    });
+    rig.wire().inject(50_000, &SERVO_PACKET);
+    rig.run_us(100);
+    rig.host.send(&frame(IS_POWERED_ON, &[]));
+    rig.run_us(10_000);
+    assert_eq!(rig.host.received(), frame(IS_POWERED_ON, &[1]));
+}
+
+#[test]
+fn a_silent_atom_times_out_and_the_next_request_still_goes() {
+    let mut rig = Rig::quiet(true);
+    rig.atom = Box::new(|_| None);
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.host.send(&frame(IS_POWERED_ON, &[]));
+    rig.run_us(100_000);
+    assert_eq!(rig.atom_got.len(), 1, "the second waits for the first");
+    rig.run_us(BasicConfig::default().reply_timeout_us);
+    assert_eq!(rig.atom_got.len(), 2);
+    let status = rig.basic.status();
+    assert_eq!(status.atom, AtomLink::Silent);
+    assert_eq!(
+        status.last_error,
+        Some(BasicError::ReplyTimeout { cmd: GET_ANGLES })
+    );
+    assert!(rig.host.received().is_empty());
+    // The Atom comes back: the next request is answered.
+    rig.atom = common::ack_everything();
+    rig.run_us(BasicConfig::default().reply_timeout_us);
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(5_000);
+    assert_eq!(rig.host.received(), angles_reply());
+    assert_eq!(rig.basic.status().atom, AtomLink::Answering);
+}
+
+#[test]
+fn own_commands_are_answered_at_once_while_the_atom_is_silent() {
+    let mut rig = Rig::quiet(true);
+    rig.atom = Box::new(|_| None);
+    rig.io.tof_mm = Some(250);
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(1_000);
+    rig.host.send(&frame(0xC0, &[]));
+    assert!(rig.run_until_host_has(7, 2_000));
+    assert_eq!(rig.host.received(), frame(0xC0, &[0, 250]));
+    assert_eq!(rig.atom_got.len(), 1, "0xC0 never reaches the bus");
+}
+
+#[test]
+fn a_late_reply_after_the_timeout_is_dropped() {
+    let mut rig = Rig::quiet(true);
+    rig.atom_delay_ns = (BasicConfig::default().reply_timeout_us + 10_000) * 1_000;
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(BasicConfig::default().reply_timeout_us + 50_000);
+    assert!(rig.host.received().is_empty());
+    assert_eq!(rig.basic.status().timeouts, 1);
+}
+
+#[test]
+fn pipelined_requests_are_forwarded_one_at_a_time_and_answered_in_order() {
+    let mut rig = Rig::quiet(false);
+    let cmds = [0x20u8, 0x12, 0x2B, 0x23, 0x14];
+    for cmd in cmds {
+        rig.host.send(&frame(cmd, &[]));
+    }
+    rig.run_us(20_000);
+    let sent: Vec<u8> = rig.atom_got.iter().map(|(_, f)| f.cmd()).collect();
+    assert_eq!(sent, cmds);
+    let answered: Vec<u8> = rig.host_frames().iter().map(Frame::cmd).collect();
+    assert_eq!(answered, cmds);
+    // Each request went out only after the previous reply arrived.
+    let wire = rig.wire();
+    assert!(wire.basic_sent.windows(2).all(|w| w[0].0 < w[1].0));
+}
+
+#[test]
+fn a_flood_beyond_the_queue_drops_requests_but_keeps_working() {
+    let mut rig = Rig::quiet(true);
+    rig.atom = Box::new(|_| None);
+    for _ in 0..20 {
+        rig.host.send(&frame(GET_ANGLES, &[]));
+    }
+    rig.run_us(5_000);
+    assert_eq!(
+        rig.basic.status().last_error,
+        Some(BasicError::QueueFull { cmd: GET_ANGLES })
+    );
+    rig.atom = common::ack_everything();
+    rig.step_ns = 20_000;
+    rig.run_us(BasicConfig::default().reply_timeout_us * 12);
+    rig.host.from_basic.clear();
+    rig.host.send(&frame(IS_POWERED_ON, &[]));
+    rig.run_us(5_000);
+    assert_eq!(rig.host.received(), frame(IS_POWERED_ON, &[1]));
+}
+
+#[test]
+fn a_collision_is_detected_and_the_request_sent_again() {
+    for echo in [true, false] {
+        let mut rig = Rig::quiet(echo);
+        let request = frame(GET_ANGLES, &[]);
+        rig.host.send(&request);
+        // The host frame's last byte ends at 5 byte times of 115200; the Basic starts sending
+        // right after. Another station talks over its second byte.
+        let host_end_ns = 5 * common::HOST_BYTE_NS;
+        rig.wire()
+            .inject(host_end_ns + BUS_BYTE_NS + 3_000, &[0x55, 0x55]);
+        rig.run_us(10_000);
+        assert!(rig.basic.status().collisions >= 1, "echo {echo}");
+        assert_eq!(rig.atom_got.len(), 1, "echo {echo}: one intact copy");
+        assert_eq!(rig.host.received(), angles_reply(), "echo {echo}");
+    }
+}
+
+#[test]
+fn the_basic_waits_for_a_quiet_wire_before_sending() {
+    let mut rig = Rig::quiet(true);
+    // The Atom is busy with a long servo exchange when the host request arrives.
+    let busy_from = 4 * common::HOST_BYTE_NS;
+    let burst: Vec<u8> = SERVO_PACKET.iter().cycle().take(200).copied().collect();
+    rig.wire().inject(busy_from, &burst);
+    let busy_until = busy_from + 200 * BUS_BYTE_NS;
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(10_000);
+    let first_sent = rig.wire().basic_sent[0].0;
+    assert!(first_sent >= busy_until + 60_000, "sent at {first_sent} ns");
+    assert_eq!(rig.basic.status().collisions, 0);
+    assert_eq!(rig.host.received(), angles_reply());
+}
+
+#[test]
+fn boot_powers_the_atom_on_without_telling_the_host() {
+    let mut rig = Rig::new(BasicConfig::default(), true);
+    rig.step_ns = 20_000;
+    rig.run_us(900_000);
+    assert!(rig.atom_got.is_empty(), "the Atom is still booting");
+    rig.run_us(200_000);
+    let got: Vec<u8> = rig.atom_got.iter().map(|(_, f)| f.cmd()).collect();
+    assert_eq!(got, [0x10]);
+    let status = rig.basic.status();
+    assert_eq!(status.atom, AtomLink::Answering);
+    assert_eq!(status.atom_powered, Some(true));
+    assert!(rig.host.received().is_empty());
+}
+
+#[test]
+fn a_silent_atom_at_boot_is_shown_and_powered_on_once_it_answers() {
+    let mut rig = Rig::new(BasicConfig::default(), false);
+    rig.step_ns = 20_000;
+    rig.atom = Box::new(|_| None);
+    rig.run_us(1_500_000);
+    assert_eq!(rig.basic.status().atom, AtomLink::Silent);
+    rig.atom = common::ack_everything();
+    rig.run_us(1_000_000);
+    let status = rig.basic.status();
+    assert_eq!(status.atom, AtomLink::Answering);
+    assert_eq!(status.atom_powered, Some(true));
+    assert!(rig.host.received().is_empty());
+    // Powered on: from now on it is only probed, with 0x12.
+    let before = rig.atom_got.len();
+    rig.run_us(2_100_000);
+    let probes: Vec<u8> = rig.atom_got[before..]
+        .iter()
+        .map(|(_, f)| f.cmd())
+        .collect();
+    assert_eq!(probes, [IS_POWERED_ON, IS_POWERED_ON]);
+    assert!(rig.host.received().is_empty());
+}
+
+#[test]
+fn a_host_request_with_the_probes_command_gets_exactly_its_own_reply() {
+    let mut rig = Rig::new(BasicConfig::default(), true);
+    rig.step_ns = 20_000;
+    rig.run_us(1_100_000);
+    rig.step_ns = 1_000;
+    rig.host.send(&frame(IS_POWERED_ON, &[]));
+    rig.run_us(10_000);
+    assert_eq!(rig.host.received(), frame(IS_POWERED_ON, &[1]));
+}
+
+#[test]
+fn a_host_power_off_cancels_the_boot_power_on() {
+    let mut rig = Rig::new(BasicConfig::default(), true);
+    rig.step_ns = 20_000;
+    rig.host.send(&frame(0x11, &[]));
+    rig.run_us(500_000);
+    assert_eq!(rig.host.received(), frame(0x11, &[1]));
+    assert_eq!(rig.basic.status().atom_powered, Some(false));
+    rig.run_us(2_000_000);
+    let got: Vec<u8> = rig.atom_got.iter().map(|(_, f)| f.cmd()).collect();
+    assert!(!got.contains(&0x10), "{got:02x?}");
+}
+
+#[test]
+fn button_a_powers_the_atom_on_again() {
+    let mut rig = Rig::quiet(true);
+    rig.run_us(1_000);
+    rig.io.buttons.a = true;
+    rig.run_us(5_000);
+    rig.io.buttons.a = false;
+    rig.run_us(5_000);
+    let got: Vec<u8> = rig.atom_got.iter().map(|(_, f)| f.cmd()).collect();
+    assert_eq!(got, [0x10]);
+    assert!(rig.host.received().is_empty());
 }

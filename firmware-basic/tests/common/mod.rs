@@ -82,9 +82,11 @@ impl Wire {
     /// What a listener hears for transmission `i`: the byte, or garbage if it overlapped.
     fn heard(&self, i: usize) -> u8 {
         let t = self.txs[i];
-        let overlaps = self.txs.iter().enumerate().any(|(j, o)| {
-            j != i && o.start_ns < t.end_ns() && t.start_ns < o.end_ns()
-        });
+        let overlaps = self
+            .txs
+            .iter()
+            .enumerate()
+            .any(|(j, o)| j != i && o.start_ns < t.end_ns() && t.start_ns < o.end_ns());
         if overlaps { t.byte ^ 0xA5 } else { t.byte }
     }
 
@@ -327,8 +329,12 @@ impl Rig {
         self.wire().advance(self.now_ns);
         self.host.now_ns = self.now_ns;
         self.run_atom();
-        self.basic
-            .poll(self.now_ns / 1_000, &mut self.host, &mut self.bus, &mut self.io);
+        self.basic.poll(
+            self.now_ns / 1_000,
+            &mut self.host,
+            &mut self.bus,
+            &mut self.io,
+        );
         self.now_ns += self.step_ns;
     }
 

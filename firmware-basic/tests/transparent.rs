@@ -1,0 +1,91 @@
+//! Transparent mode: raw bytes both ways, until the host sends `FE FE 03 C2 00 FA`.
+#![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+
+mod common;
+
+use common::{BUS_BYTE_NS, Rig, frame};
+use firmware_basic::TransponderMode;
+
+/// PING servo 1, and its status reply.
+const PING: [u8; 6] = [0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB];
+const PING_REPLY: [u8; 6] = [0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC];
+
+fn enter(rig: &mut Rig) {
+    rig.host.send(&frame(0xC2, &[1]));
+    rig.run_us(2_000);
+    assert_eq!(rig.host.received(), frame(0xC2, &[1]));
+    assert_eq!(rig.basic.status().mode, TransponderMode::Transparent);
+    rig.host.from_basic.clear();
+}
+
+#[test]
+fn raw_servo_traffic_passes_both_ways_without_the_echo() {
+    for echo in [true, false] {
+        let mut rig = Rig::quiet(echo);
+        // One framed exchange first, so the Basic knows whether the wire echoes.
+        rig.host.send(&frame(0x20, &[]));
+        rig.run_us(5_000);
+        rig.host.from_basic.clear();
+        enter(&mut rig);
+        rig.atom = Box::new(|_| None);
+        rig.host.send(&PING);
+        rig.run_us(2_000);
+        let sent: Vec<u8> = rig.wire().basic_sent.iter().map(|&(_, b)| b).collect();
+        assert!(sent.ends_with(&PING), "echo {echo}: {sent:02x?}");
+        let now = rig.now_ns;
+        rig.wire().inject(now + 50_000, &PING_REPLY);
+        rig.run_us(1_000);
+        assert_eq!(rig.host.received(), PING_REPLY, "echo {echo}");
+    }
+}
+
+#[test]
+fn host_frames_are_not_interpreted_in_transparent_mode() {
+    let mut rig = Rig::quiet(true);
+    rig.atom = Box::new(|_| None);
+    enter(&mut rig);
+    // 0xC1 (Basic version) would be answered in framed mode; here it goes to the bus as is.
+    let version = frame(0xC1, &[]);
+    rig.host.send(&version);
+    rig.run_us(3_000);
+    assert!(rig.host.received().is_empty());
+    let sent: Vec<u8> = rig.wire().basic_sent.iter().map(|&(_, b)| b).collect();
+    assert_eq!(sent, version);
+}
+
+#[test]
+fn the_exit_frame_returns_to_framed_mode_and_is_acknowledged() {
+    let mut rig = Rig::quiet(true);
+    enter(&mut rig);
+    let sent_before = rig.wire().basic_sent.len();
+    rig.host.send(&frame(0xC2, &[0]));
+    rig.run_us(2_000);
+    assert_eq!(rig.host.received(), frame(0xC2, &[1]));
+    assert_eq!(rig.basic.status().mode, TransponderMode::Framed);
+    assert_eq!(
+        rig.wire().basic_sent.len(),
+        sent_before,
+        "the exit frame stays off the bus"
+    );
+    // Framed again: own commands answered, Atom commands forwarded.
+    rig.host.from_basic.clear();
+    rig.host.send(&frame(0xC3, &[]));
+    rig.run_us(2_000);
+    assert_eq!(rig.host.received(), frame(0xC3, &[0]));
+    rig.host.from_basic.clear();
+    rig.host.send(&frame(0x12, &[]));
+    rig.run_us(5_000);
+    assert_eq!(rig.host.received(), frame(0x12, &[1]));
+}
+
+#[test]
+fn bus_bytes_faster_than_the_host_link_are_queued_not_lost() {
+    let mut rig = Rig::quiet(false);
+    enter(&mut rig);
+    // 300 bytes at 1 Mbaud arrive in 3 ms; the host link needs 26 ms for them.
+    let burst: Vec<u8> = (0..300u32).map(|i| (i % 251) as u8).collect();
+    let now = rig.now_ns;
+    rig.wire().inject(now + 10 * BUS_BYTE_NS, &burst);
+    rig.run_us(40_000);
+    assert_eq!(rig.host.received(), burst);
+}
