@@ -172,3 +172,39 @@ impl ServoErrorCode {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn error_codes_round_trip_and_match_protocol_md() {
+        for code in 0..=255u8 {
+            if let Some(e) = ErrorCode::from_code(code) {
+                assert_eq!(e.code(), code);
+            }
+        }
+        assert_eq!(ErrorCode::IkNoSolution.code(), 32);
+        assert_eq!(ErrorCode::JointLimit(JointId::new(6).unwrap()).code(), 6);
+        assert_eq!(ErrorCode::from_code(7), None);
+        assert_eq!(
+            ErrorCode::from_code(34),
+            Some(ErrorCode::LinearNoAdjacentSolution(1))
+        );
+    }
+
+    #[test]
+    fn servo_error_codes_land_in_pymycobot_ranges() {
+        assert!((16..=22).contains(&ServoErrorCode::NoAnswer.code()));
+        assert!((16..=22).contains(&ServoErrorCode::BadAnswer.code()));
+        assert!((23..=28).contains(&ServoErrorCode::PositionError.code()));
+        for bits in 0..=u8::MAX {
+            let code = ServoErrorCode::Fault(bits).code();
+            assert!((32..=111).contains(&code), "bits {bits} -> {code}");
+            assert_eq!(
+                ServoErrorCode::from_code(code),
+                Some(ServoErrorCode::Fault(bits & ServoErrorCode::FAULT_MASK))
+            );
+        }
+    }
+}

@@ -267,3 +267,27 @@ pub mod cmd {
 pub const fn is_basic_local(code: u8) -> bool {
     matches!(code, 0xA0 | 0xA1 | 0xB0..=0xB2 | 0xC0..=0xC3)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn basic_answers_its_own_io_tof_version_mode_and_wifi() {
+        let local: std::vec::Vec<u8> = cmd::ALL
+            .into_iter()
+            .filter(|&c| is_basic_local(c))
+            .collect();
+        assert_eq!(
+            local,
+            [0xA0, 0xA1, 0xB0, 0xB1, 0xB2, 0xC0, 0xC1, 0xC2, 0xC3]
+        );
+    }
+
+    #[test]
+    fn every_known_code_is_known_and_others_are_not() {
+        let known = (0..=255u8).filter(|&c| cmd::is_known(c)).count();
+        assert_eq!(known, cmd::ALL.len());
+        assert!(!cmd::is_known(0x00) && !cmd::is_known(0xFE));
+    }
+}

@@ -1415,3 +1415,135 @@ fn gripper_model(w: &mut Writer, model: GripperModel) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(cmd: u8, data: &[u8]) -> Result<Request, CommandError> {
+        Request::parse(&Frame::new(cmd, data).unwrap())
+    }
+
+    #[test]
+    fn impossible_values_are_errors_not_commands() {
+        use CommandError as E;
+        let cases: &[(u8, &[u8], CommandError)] = &[
+            (cmd::SEND_ANGLE, &[9, 0, 0, 50], E::BadJoint(9)),
+            (cmd::SEND_ANGLE, &[0, 0, 0, 50], E::BadJoint(0)),
+            (cmd::SEND_ANGLE, &[1, 0, 0, 0], E::BadSpeed(0)),
+            (cmd::SEND_ANGLE, &[1, 0, 0, 200], E::BadSpeed(200)),
+            (cmd::SEND_COORD, &[7, 0, 0, 50], E::BadAxis(7)),
+            (cmd::JOG_RPY, &[4, 0, 50], E::BadAxis(4)),
+            (cmd::JOG_ANGLE, &[1, 2, 50], E::BadDirection(2)),
+            (cmd::GET_ENCODER, &[8], E::BadServo(8)),
+            (cmd::SET_ENCODER, &[1, 0x10, 0x01, 50], E::BadEncoder(4097)),
+            (cmd::SET_ENCODER, &[1, 0xFF, 0xFF], E::BadEncoder(-1)),
+            (cmd::SET_DIGITAL_OUTPUT, &[39, 1], E::BadPin(39)),
+            (cmd::SET_DIGITAL_OUTPUT, &[25, 1], E::BadPin(25)),
+            (cmd::SET_PIN_MODE, &[39, 1], E::BadPin(39)),
+            (cmd::SET_PIN_MODE, &[19, 3], E::BadFlag(3)),
+            (cmd::SET_BASIC_OUTPUT, &[35, 1], E::BadPin(35)),
+            (cmd::GET_BASIC_INPUT, &[2], E::BadPin(2)),
+            (cmd::SET_FREE_MODE, &[2], E::BadFlag(2)),
+            (cmd::SEND_COORDS, &[0; 14], E::BadSpeed(0)),
+            (cmd::SET_GRIPPER_VALUE, &[101, 50], E::BadGripperValue(101)),
+            (cmd::SET_GRIPPER_VALUE, &[50, 101], E::BadSpeed(101)),
+            (cmd::SET_GRIPPER_STATE, &[2, 50], E::BadGripperValue(2)),
+            (cmd::SET_GRIPPER_STATE, &[1, 50, 6], E::BadGripperValue(6)),
+            (cmd::SET_GRIPPER_STATE, &[1, 50, 1, 2], E::BadFlag(2)),
+            (
+                cmd::SET_HTS_GRIPPER_TORQUE,
+                &[0, 100],
+                E::BadGripperSetting(100),
+            ),
+            (
+                cmd::SET_GRIPPER_PROTECT_CURRENT,
+                &[0, 0],
+                E::BadGripperSetting(0),
+            ),
+            (cmd::SET_SERVO_DATA, &[1, 3, 0], E::BadAddress(3)),
+            (cmd::SET_SERVO_DATA, &[1, 42, 8, 0, 0], E::BadFlag(0)),
+            (cmd::FOCUS_SERVO, &[254], E::BadServo(254)),
+            (cmd::BACKUP_SERVO_PARAMS, &[0], E::BadServo(0)),
+            (
+                cmd::IS_IN_POSITION,
+                &[0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2],
+                E::BadFlag(2),
+            ),
+        ];
+        for (code, data, want) in cases {
+            assert_eq!(parse(*code, data), Err(*want), "{code:#04x} {data:02x?}");
+        }
+    }
+
+    #[test]
+    fn unknown_command_and_unknown_layout_are_told_apart() {
+        assert_eq!(
+            parse(0x03, &[]),
+            Err(CommandError::UnknownCommand { cmd: 0x03 })
+        );
+        assert_eq!(
+            parse(0xFF, &[1, 2]),
+            Err(CommandError::UnknownCommand { cmd: 0xFF })
+        );
+        for (code, len) in [
+            (cmd::GET_ANGLES, 1),
+            (cmd::SEND_ANGLES, 12),
+            (cmd::SEND_COORDS, 15),
+        ] {
+            assert_eq!(
+                parse(code, &[1; 20][..len]),
+                Err(CommandError::BadLength {
+                    cmd: code,
+                    data_len: len as u8
+                })
+            );
+        }
+    }
+
+    #[test]
+    fn layouts_of_one_command_are_told_apart_by_length() {
+        assert_eq!(parse(cmd::GET_COORDS, &[]), Ok(Request::GetCoords));
+        assert!(matches!(
+            parse(cmd::GET_COORDS, &[0; 12]),
+            Ok(Request::AnglesToCoords { .. })
+        ));
+        assert_eq!(parse(cmd::JOG_STOP, &[]), Ok(Request::JogStop));
+        assert!(matches!(
+            parse(cmd::JOG_INCREMENT_COORD, &[3, 0xFF, 0xFA, 10]),
+            Ok(Request::JogIncrementCoord {
+                increment: AxisValue::Z(crate::units::DeciMm(-6)),
+                ..
+            })
+        ));
+        assert!(matches!(
+            parse(cmd::SET_SERVO_DATA, &[1, 42, 0x08, 0x00, 1]),
+            Ok(Request::SetServoData {
+                value: ServoValue::Word(2048),
+                ..
+            })
+        ));
+        assert!(matches!(
+            parse(cmd::SET_SERVO_DATA, &[1, 42, 7]),
+            Ok(Request::SetServoData {
+                value: ServoValue::Byte(7),
+                ..
+            })
+        ));
+        assert!(matches!(
+            parse(cmd::SET_GRIPPER_STATE, &[1]),
+            Ok(Request::SetGripperStateNoSpeed { .. })
+        ));
+    }
+
+    #[test]
+    fn reply_kinds_fit_pymycobot_limit() {
+        // Every request kind's reply has at most 28 data bytes.
+        use super::super::Reply;
+        let biggest = Reply::AnglesAndCoords {
+            angles: [Centideg(0); 6],
+            coords: Pose::default(),
+        };
+        assert!(biggest.to_frame(cmd::GET_ANGLES_COORDS).data().len() <= 28);
+    }
+}
