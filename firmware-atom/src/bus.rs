@@ -92,9 +92,10 @@ impl BusReceiver {
     /// short by a quiet line. Call once per poll, after the received bytes.
     pub fn on_time(&mut self, now_us: u64, on_event: &mut impl FnMut(BusEvent)) {
         if now_us > self.echo_deadline_us && !self.expected_echo.is_empty() {
-            // The echo never (fully) came: a line without echo. Matched bytes were ours.
+            // The echo never (fully) came: a line without echo. The bytes that matched so far
+            // may be the start of a servo's answer (it begins like the instruction did).
             self.expected_echo.clear();
-            self.held.clear();
+            self.release_held(on_event);
         }
         let quiet_us = now_us.saturating_sub(self.last_activity_us);
         if quiet_us >= PACKET_GAP_US && self.packets.has_partial() {

@@ -5,11 +5,18 @@
 //! Servos answer PING, READ, WRITE, SYNC READ and SYNC WRITE; they move toward their goal at
 //! the goal speed. A servo can be removed, made to drop answers, or to corrupt checksums.
 //! Bytes are not corrupted by overlap (the root package's simulator models that).
-#![allow(dead_code, clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
+#![allow(
+    dead_code,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing
+)]
 
 use std::collections::VecDeque;
 
-use protocol_core::servo::{Instruction, Packet, PacketDecoder, reg, sign_magnitude, to_sign_magnitude};
+use protocol_core::servo::{
+    Instruction, Packet, PacketDecoder, reg, sign_magnitude, to_sign_magnitude,
+};
 use protocol_core::{BytePort, Frame, FrameDecoder};
 
 /// Wire time of one byte at 1 Mbaud, microseconds.
@@ -141,7 +148,9 @@ impl FakeServo {
             self.table[a] = b;
         }
         let goal_range = reg::GOAL_POSITION..reg::GOAL_POSITION + 2;
-        if goal_range.contains(&addr) || (addr..addr + data.len() as u8).contains(&reg::GOAL_POSITION) {
+        if goal_range.contains(&addr)
+            || (addr..addr + data.len() as u8).contains(&reg::GOAL_POSITION)
+        {
             let g = self.goal();
             self.goals.push(g);
         }
@@ -228,9 +237,7 @@ impl FakeBus {
     }
 
     fn sort(&mut self) {
-        self.to_atom
-            .make_contiguous()
-            .sort_by_key(|t| t.at_us);
+        self.to_atom.make_contiguous().sort_by_key(|t| t.at_us);
     }
 
     /// Advances every servo's motion to the current time.
@@ -294,7 +301,10 @@ impl FakeBus {
                         }
                         for b in bytes {
                             answer_at += BYTE_US;
-                            self.to_atom.push_back(Timed { at_us: answer_at, byte: b });
+                            self.to_atom.push_back(Timed {
+                                at_us: answer_at,
+                                byte: b,
+                            });
                         }
                     }
                 }
@@ -303,7 +313,10 @@ impl FakeBus {
         for p in answers {
             for b in p.to_bytes() {
                 answer_at += BYTE_US;
-                self.to_atom.push_back(Timed { at_us: answer_at, byte: b });
+                self.to_atom.push_back(Timed {
+                    at_us: answer_at,
+                    byte: b,
+                });
             }
         }
         self.wire_free_us = self.wire_free_us.max(answer_at);
@@ -376,3 +389,4 @@ impl BytePort for FakeUsb {
         true
     }
 }
+pub mod rig;

@@ -1,0 +1,389 @@
+//! The Atom answering host commands like a user's script would drive it, against fake servos.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
+
+mod support;
+
+use protocol_core::Frame;
+use support::rig::{Rig, be};
+
+const GET_ANGLES: u8 = 0x20;
+const SEND_ANGLES: u8 = 0x22;
+
+fn angles(rig: &mut Rig) -> Vec<i16> {
+    rig.ask_i16(GET_ANGLES, &[])
+}
+
+fn close(a: &[i16], b: &[i16], tol: i16) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tol)
+}
+
+#[test]
+fn starts_at_zero_and_powered() {
+    let mut rig = Rig::new();
+    assert_eq!(angles(&mut rig), [0; 6]);
+    assert_eq!(rig.ask(0x12, &[]), [1]);
+    assert_eq!(rig.ask(0x07, &[]), [0]);
+}
+
+#[test]
+fn send_angles_moves_all_joints_to_arrive_together() {
+    let mut rig = Rig::new();
+    let target = [3000i16, -2000, 1500, 0, 4500, -9000];
+    let mut data = be(&target);
+    data.push(80);
+    assert_eq!(rig.ask(SEND_ANGLES, &data), [1]);
+    rig.run_ms(50);
+    assert_eq!(rig.ask(0x2B, &[]), [1], "is moving");
+    // Joints 1 (30 deg) and 6 (90 deg) started together: halfway through, both have covered
+    // about the same share of their travel.
+    rig.run_ms(400);
+    let mid = angles(&mut rig);
+    let share1 = f64::from(mid[0]) / 3000.0;
+    let share6 = f64::from(mid[5]) / -9000.0;
+    assert!((share1 - share6).abs() < 0.1, "{mid:?}");
+    rig.run_ms(3000);
+    let end = angles(&mut rig);
+    assert!(close(&end, &target, 10), "{end:?}");
+    assert_eq!(rig.ask(0x2B, &[]), [0], "not moving after arrival");
+    let mut pos = be(&target);
+    pos.push(0);
+    assert_eq!(rig.ask(0x2A, &pos), [1], "in position");
+}
+
+#[test]
+fn out_of_limit_angle_is_refused_and_changes_nothing() {
+    let mut rig = Rig::new();
+    let goals_before = rig.bus.servo(2).goals.len();
+    let mut data = be(&[0, 15_000, 0, 0, 0, 0]); // J2 limit is 140 deg
+    data.push(50);
+    assert_eq!(rig.ask(SEND_ANGLES, &data), [0]);
+    assert_eq!(rig.ask(0x07, &[]), [2], "error code names joint 2");
+    rig.run_ms(100);
+    assert_eq!(rig.bus.servo(2).goals.len(), goals_before);
+    assert_eq!(angles(&mut rig), [0; 6]);
+    assert_eq!(rig.ask(0x08, &[]), [1]);
+    assert_eq!(rig.ask(0x07, &[]), [0]);
+}
+
+#[test]
+fn lowered_joint_limit_is_enforced() {
+    let mut rig = Rig::new();
+    // Joint 1 max = 10.0 deg (wire: deg x 10).
+    let mut data = vec![1];
+    data.extend(be(&[100]));
+    assert_eq!(rig.ask(0x4D, &data), [1]);
+    assert_eq!(rig.ask(0x4B, &[1]), [1, 0, 100]);
+    let mut send = vec![1];
+    send.extend(be(&[2000]));
+    send.push(50);
+    assert_eq!(rig.ask(0x21, &send), [0]);
+    assert_eq!(rig.ask(0x07, &[]), [1]);
+}
+
+#[test]
+fn power_off_refuses_motion_and_power_on_restores_it() {
+    let mut rig = Rig::new();
+    assert_eq!(rig.ask(0x11, &[]), [1]);
+    assert_eq!(rig.ask(0x12, &[]), [0]);
+    rig.run_ms(20);
+    assert!(!rig.bus.servo(1).torque_on());
+    let mut send = vec![1];
+    send.extend(be(&[2000]));
+    send.push(50);
+    assert_eq!(rig.ask(0x21, &send), [0]);
+    assert_eq!(rig.ask(0x10, &[]), [1]);
+    rig.run_ms(20);
+    assert!(rig.bus.servo(1).torque_on());
+    assert_eq!(rig.ask(0x21, &send), [1]);
+    rig.run_ms(2000);
+    assert!(close(&angles(&mut rig)[..1], &[2000], 10));
+}
+
+#[test]
+fn stop_holds_where_the_arm_is() {
+    let mut rig = Rig::new();
+    let mut data = be(&[9000, 0, 0, 0, 0, 0]);
+    data.push(30);
+    rig.ask(SEND_ANGLES, &data);
+    rig.run_ms(500);
+    assert_eq!(rig.ask(0x29, &[]), [1]);
+    rig.run_ms(300);
+    let a = angles(&mut rig)[0];
+    rig.run_ms(1000);
+    assert_eq!(angles(&mut rig)[0], a, "stays put after stop");
+    assert!(a > 0 && a < 9000);
+}
+
+#[test]
+fn pause_and_resume_finish_the_move() {
+    let mut rig = Rig::new();
+    let mut data = be(&[6000, 0, 0, 0, 0, 0]);
+    data.push(30);
+    rig.ask(SEND_ANGLES, &data);
+    rig.run_ms(300);
+    assert_eq!(rig.ask(0x26, &[]), [1]);
+    assert_eq!(rig.ask(0x27, &[]), [1], "is paused");
+    rig.run_ms(1500);
+    let held = angles(&mut rig)[0];
+    assert!(held < 6000);
+    assert_eq!(rig.ask(0x28, &[]), [1]);
+    rig.run_ms(4000);
+    assert!(close(&angles(&mut rig)[..1], &[6000], 10));
+}
+
+#[test]
+fn queue_mode_runs_moves_in_order() {
+    let mut rig = Rig::new();
+    assert_eq!(rig.ask(0x16, &[0]), [1]);
+    assert_eq!(rig.ask(0x17, &[]), [0]);
+    let mut first = vec![1];
+    first.extend(be(&[3000]));
+    first.push(100);
+    let mut second = vec![1];
+    second.extend(be(&[-3000]));
+    second.push(100);
+    rig.ask(0x21, &first);
+    rig.ask(0x21, &second);
+    let mut max_seen = 0;
+    for _ in 0..40 {
+        rig.run_ms(100);
+        max_seen = max_seen.max(angles(&mut rig)[0]);
+    }
+    assert!(max_seen > 2900, "first move ran: {max_seen}");
+    assert!(close(&angles(&mut rig)[..1], &[-3000], 10));
+}
+
+#[test]
+fn jog_runs_until_stopped() {
+    let mut rig = Rig::new();
+    assert_eq!(rig.ask(0x30, &[1, 1, 50]), [1]);
+    rig.run_ms(500);
+    let a = angles(&mut rig)[0];
+    assert!(a > 500, "{a}");
+    assert_eq!(rig.ask(0x34, &[]), [1], "jog stop (LEN 2)");
+    rig.run_ms(500);
+    let b = angles(&mut rig)[0];
+    rig.run_ms(500);
+    assert_eq!(angles(&mut rig)[0], b);
+}
+
+#[test]
+fn jog_stops_by_itself_when_the_host_goes_silent() {
+    let mut rig = Rig::new();
+    assert_eq!(rig.ask(0x30, &[1, 0, 5]), [1]);
+    rig.run_ms(3000);
+    let a = rig.atom.present_angles()[0].0;
+    rig.run_ms(2000);
+    assert_eq!(rig.atom.present_angles()[0].0, a, "stopped by the watchdog");
+    assert!(a > -16_800, "stopped before the limit: {a}");
+}
+
+#[test]
+fn increment_jog_moves_relative() {
+    let mut rig = Rig::new();
+    let mut data = vec![3];
+    data.extend(be(&[1000]));
+    data.push(100);
+    assert_eq!(rig.ask(0x33, &data), [1]);
+    rig.run_ms(1500);
+    assert_eq!(rig.ask(0x33, &data), [1]);
+    rig.run_ms(1500);
+    assert!(close(&angles(&mut rig)[2..3], &[2000], 10));
+}
+
+#[test]
+fn encoders_round_trip() {
+    let mut rig = Rig::new();
+    let mut data = vec![2];
+    data.extend(be(&[2548]));
+    data.push(100);
+    assert_eq!(rig.ask(0x3A, &data), [1]);
+    rig.run_ms(1500);
+    assert_eq!(rig.ask_i16(0x3B, &[2]), [2548]);
+    let enc = rig.ask_i16(0x3D, &[]);
+    assert_eq!(enc[1], 2548);
+    // An encoder past the joint limit is refused.
+    let mut bad = vec![2];
+    bad.extend(be(&[4000]));
+    bad.push(100);
+    assert_eq!(rig.ask(0x3A, &bad), [0]);
+}
+
+#[test]
+fn coords_at_zero_pose_and_joint_move_to_coords() {
+    let mut rig = Rig::new();
+    let c = rig.ask_i16(0x23, &[]);
+    assert!(close(&c, &[456, -634, 4127, -9000, 0, -9000], 2), "{c:?}");
+    // A reachable pose: the pose at some joint angles.
+    let q = [1000i16, -2000, -3000, 2000, 1000, 500];
+    let pose = rig.ask_i16(0x23, &be(&q));
+    let mut data = be(&pose);
+    data.push(50);
+    data.push(0);
+    assert_eq!(rig.ask(0x25, &data), [1]);
+    rig.run_ms(4000);
+    let now = rig.ask_i16(0x23, &[]);
+    assert!(close(&now[..3], &pose[..3], 20), "{now:?} vs {pose:?}");
+}
+
+#[test]
+fn unreachable_coords_are_refused_with_error_32() {
+    let mut rig = Rig::new();
+    let mut data = be(&[3000, 3000, 3000, 0, 0, 0]);
+    data.push(50);
+    assert_eq!(rig.ask(0x25, &data), [0]);
+    assert_eq!(rig.ask(0x07, &[]), [32]);
+    assert_eq!(angles(&mut rig), [0; 6]);
+}
+
+#[test]
+fn gripper_value_and_state() {
+    let mut rig = Rig::new();
+    assert_eq!(rig.ask(0x67, &[60, 100]), [1]);
+    rig.run_ms(1500);
+    let v = rig.ask(0x65, &[])[0];
+    assert!((59..=61).contains(&v), "{v}");
+    assert_eq!(rig.ask(0x66, &[1, 100]), [1], "close");
+    rig.run_ms(1500);
+    assert_eq!(rig.ask(0x65, &[]), [0]);
+    assert_eq!(rig.ask(0x69, &[]), [0], "not moving");
+}
+
+#[test]
+fn servo_data_read_and_eeprom_write() {
+    let mut rig = Rig::new();
+    // Read present temperature (addr 63) of servo 3.
+    assert_eq!(rig.ask(0x53, &[3, 63]), [31]);
+    // Two-byte read of the present position.
+    assert_eq!(rig.ask(0x53, &[3, 56, 1]), [0x08, 0x00]);
+    // EEPROM write (P coefficient, addr 21): unlocked, written, locked again.
+    assert_eq!(rig.ask(0x52, &[3, 21, 40]), [1]);
+    rig.run_ms(10);
+    assert_eq!(rig.bus.servo(3).table[21], 40);
+    assert_eq!(rig.bus.servo(3).table[55], 1, "EEPROM locked again");
+    // A raw write to the goal register goes through the limits.
+    let mut goal = vec![1, 42];
+    goal.extend(be(&[4095]));
+    goal.push(1);
+    let _ = rig.ask(0x52, &goal);
+    rig.run_ms(10);
+    assert!(rig.bus.servo(1).goals.iter().all(|&g| g < 4000));
+}
+
+#[test]
+fn missing_servo_is_reported_and_others_keep_working() {
+    let mut rig = Rig::new();
+    rig.bus.servo(4).present = false;
+    rig.run_ms(50);
+    assert_eq!(rig.ask(0x50, &[4]), [4, 0]);
+    assert_eq!(rig.ask(0x50, &[3]), [3, 1]);
+    assert_eq!(rig.ask(0x51, &[]), [0]);
+    let errors = rig.ask(0x15, &[]);
+    assert_eq!(errors, [0, 0, 0, 16, 0, 0, 0]);
+    // Reading the missing servo answers (after bounded retries) instead of hanging.
+    assert_eq!(rig.ask(0x53, &[4, 63]), [0xFF]);
+    let mut data = be(&[1000, 0, 0, 0, 0, 0]);
+    data.push(100);
+    assert_eq!(rig.ask(SEND_ANGLES, &data), [1]);
+    rig.run_ms(1500);
+    assert!(close(&angles(&mut rig)[..1], &[1000], 10));
+}
+
+#[test]
+fn servo_fault_is_reported() {
+    let mut rig = Rig::new();
+    rig.bus.servo(5).table[65] = 4; // overheat
+    rig.run_ms(20);
+    let status = rig.ask(0xE4, &[]);
+    assert_eq!(status, [0, 0, 0, 0, 4, 0]);
+    assert_eq!(rig.ask(0x15, &[])[4], 36);
+    assert_eq!(rig.ask(0xE5, &[]), [31; 6]);
+    assert_eq!(rig.ask(0xE3, &[]), [120; 6]);
+}
+
+#[test]
+fn corrupt_answers_are_retried() {
+    let mut rig = Rig::new();
+    rig.bus.servo(2).corrupt_answers = 1;
+    assert_eq!(rig.ask(0x53, &[2, 63]), [31]);
+}
+
+#[test]
+fn pins_leds_and_button() {
+    let mut rig = Rig::new();
+    assert_eq!(rig.ask(0x60, &[22, 1]), [1]);
+    assert_eq!(rig.ask(0x61, &[22, 1]), [1]);
+    assert_eq!(rig.ask(0x62, &[22]), [22, 1]);
+    assert_eq!(rig.ask(0x61, &[39, 1]), [0], "39 is input only");
+    assert_eq!(rig.ask(0x64, &[23, 0x03, 0xE8, 128]), [1]);
+    assert_eq!(rig.io.pwm[2], Some((1000, 128)));
+    assert_eq!(rig.ask(0x6A, &[255, 0, 10]), [1]);
+    assert_eq!(rig.io.rgb, (255, 0, 10));
+    rig.io.button = true;
+    assert_eq!(rig.ask(0x62, &[39]), [39, 0], "button pressed reads low");
+}
+
+#[test]
+fn every_command_gets_one_reply_with_its_cmd_even_when_invalid() {
+    let mut rig = Rig::new();
+    for (cmd, data) in [
+        (0x21u8, vec![9, 0, 0, 50]), // joint 9
+        (0x22, vec![0; 3]),          // wrong length
+        (0x77, vec![]),              // unknown
+        (0x30, vec![1, 1, 0]),       // speed 0
+        (0x02, vec![]),
+        (0x14, vec![]),
+    ] {
+        let seen = rig.bus.replies.len();
+        let reply = rig.request(&Frame::new(cmd, &data).unwrap()).unwrap();
+        assert_eq!(reply.cmd(), cmd);
+        assert!(!reply.data().is_empty(), "never the data-less status frame");
+        rig.run_ms(20);
+        assert_eq!(
+            rig.bus.replies.len(),
+            seen + 1,
+            "exactly one reply to {cmd:#04x}"
+        );
+    }
+}
+
+#[test]
+fn works_on_a_bus_without_echo() {
+    let mut rig = Rig::with(
+        firmware_atom::AtomConfig {
+            powered_at_boot: true,
+            ..Default::default()
+        },
+        false,
+    );
+    assert_eq!(rig.ask(0x53, &[1, 63]), [31]);
+    let mut data = be(&[1000, 0, 0, 0, 0, 0]);
+    data.push(100);
+    assert_eq!(rig.ask(SEND_ANGLES, &data), [1]);
+    rig.run_ms(1500);
+    assert!(close(&angles(&mut rig)[..1], &[1000], 10));
+}
+
+#[test]
+fn usb_link_gets_the_same_commands() {
+    let mut rig = Rig::new();
+    rig.usb.send_frame(&Frame::new(GET_ANGLES, &[]).unwrap());
+    rig.usb.send_frame(&Frame::new(0x12, &[]).unwrap());
+    rig.run_ms(5);
+    assert_eq!(rig.usb.replies.len(), 2);
+    assert_eq!(rig.usb.replies[0].cmd(), GET_ANGLES);
+    assert_eq!(rig.usb.replies[1].data(), [1]);
+    // get servo data over USB: the reply comes back on USB after the servo read.
+    rig.usb.send_frame(&Frame::new(0x53, &[1, 63]).unwrap());
+    rig.run_ms(10);
+    assert_eq!(rig.usb.replies[2].data(), [31]);
+}
+
+#[test]
+fn state_refresh_runs_at_100_hz_or_faster() {
+    let mut rig = Rig::new();
+    let before = rig.atom.refresh_rounds();
+    rig.run_ms(100);
+    let rounds = rig.atom.refresh_rounds() - before;
+    assert!(rounds >= 10, "{rounds} rounds in 100 ms");
+}

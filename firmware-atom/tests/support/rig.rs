@@ -1,0 +1,115 @@
+//! A test rig: the Atom, the fake bus with servos, a USB link and recording IO, under virtual
+//! time, with a request/reply helper that behaves like the Basic (waits for a quiet wire).
+#![allow(
+    dead_code,
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::indexing_slicing
+)]
+
+use firmware_atom::{Atom, AtomConfig, RecordingIo};
+use protocol_core::Frame;
+use protocol_core::timing::BUS_QUIET_BEFORE_SEND_US;
+
+use super::{FakeBus, FakeUsb};
+
+/// Poll period of the rig, microseconds (the contract: at least every 10 us).
+pub const TICK_US: u64 = 5;
+
+pub struct Rig {
+    pub atom: Atom,
+    pub bus: FakeBus,
+    pub usb: FakeUsb,
+    pub io: RecordingIo,
+}
+
+impl Rig {
+    /// The default arm, powered, with echo on the bus, after the first refresh rounds.
+    pub fn new() -> Self {
+        Self::with(
+            AtomConfig {
+                powered_at_boot: true,
+                ..AtomConfig::default()
+            },
+            true,
+        )
+    }
+
+    pub fn with(config: AtomConfig, echo: bool) -> Self {
+        let mut rig = Self {
+            atom: Atom::new(config),
+            bus: FakeBus::new(echo),
+            usb: FakeUsb::default(),
+            io: RecordingIo::default(),
+        };
+        rig.run_ms(20);
+        rig
+    }
+
+    pub fn now(&self) -> u64 {
+        self.bus.now_us
+    }
+
+    pub fn tick(&mut self) {
+        self.bus.now_us += TICK_US;
+        let now = self.bus.now_us;
+        self.atom
+            .poll(now, &mut self.bus, &mut self.usb, &mut self.io);
+    }
+
+    pub fn run_us(&mut self, us: u64) {
+        let end = self.bus.now_us + us;
+        while self.bus.now_us < end {
+            self.tick();
+        }
+    }
+
+    pub fn run_ms(&mut self, ms: u64) {
+        self.run_us(ms * 1000);
+    }
+
+    /// Sends `frame` on the bus like the Basic (after a quiet wire) and returns the first reply
+    /// frame with the time from the request's last byte to the reply's last byte, or `None`
+    /// after 600 ms.
+    pub fn request_timed(&mut self, frame: &Frame) -> Option<(Frame, u64)> {
+        while self.bus.quiet_us() < BUS_QUIET_BEFORE_SEND_US {
+            self.tick();
+        }
+        let seen = self.bus.replies.len();
+        let end = self.bus.send_frame(frame);
+        let deadline = self.now() + 600_000;
+        while self.now() < deadline {
+            self.tick();
+            if let Some(r) = self.bus.replies.get(seen) {
+                return Some((r.frame.clone(), r.end_us.saturating_sub(end)));
+            }
+        }
+        None
+    }
+
+    pub fn request(&mut self, frame: &Frame) -> Option<Frame> {
+        self.request_timed(frame).map(|(f, _)| f)
+    }
+
+    /// Sends a request given as command code and data; returns the reply data.
+    pub fn ask(&mut self, cmd: u8, data: &[u8]) -> Vec<u8> {
+        let reply = self
+            .request(&Frame::new(cmd, data).unwrap())
+            .unwrap_or_else(|| panic!("no reply to {cmd:#04x}"));
+        assert_eq!(reply.cmd(), cmd, "reply carries the request's CMD");
+        reply.data().to_vec()
+    }
+
+    /// The int16 values of a reply.
+    pub fn ask_i16(&mut self, cmd: u8, data: &[u8]) -> Vec<i16> {
+        self.ask(cmd, data)
+            .chunks(2)
+            .map(|c| i16::from_be_bytes([c[0], c[1]]))
+            .collect()
+    }
+}
+
+/// Big-endian int16 bytes of several values, for building requests.
+pub fn be(values: &[i16]) -> Vec<u8> {
+    values.iter().flat_map(|v| v.to_be_bytes()).collect()
+}
