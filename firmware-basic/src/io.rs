@@ -1,20 +1,12 @@
 //! What the Basic's board gives the transponder: two user outputs, two user inputs, an optional
 //! ToF distance sensor and the three front buttons (`hardware.md`).
 
+use protocol_core::command::{BasicInputPin, BasicOutputPin};
+
 /// User output pins a client may drive with 0xA0 (GPIO5 drives the suction-pump valve).
-pub const OUTPUT_PINS: [u8; 2] = [2, 5];
+pub const OUTPUT_PINS: [u8; 2] = BasicOutputPin::ALLOWED;
 /// User input pins a client may read with 0xA1 (input-only GPIOs).
-pub const INPUT_PINS: [u8; 2] = [35, 36];
-
-/// True if `pin` is one of the [`OUTPUT_PINS`].
-pub fn is_output_pin(pin: u8) -> bool {
-    OUTPUT_PINS.contains(&pin)
-}
-
-/// True if `pin` is one of the [`INPUT_PINS`].
-pub fn is_input_pin(pin: u8) -> bool {
-    INPUT_PINS.contains(&pin)
-}
+pub const INPUT_PINS: [u8; 2] = BasicInputPin::ALLOWED;
 
 /// The state of the Basic's three front buttons (true = pressed).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

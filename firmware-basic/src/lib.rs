@@ -32,6 +32,7 @@ pub use status::{AtomLink, BasicError, BasicStatus, TransponderMode};
 
 use forwarder::{Forwarder, Origin, Request};
 use host_link::{HOST_READ_BUDGET, HostLink};
+use protocol_core::command::{Reply, cmd};
 use protocol_core::{BytePort, Frame};
 use supervisor::Supervisor;
 use transparent::Transparent;
@@ -248,8 +249,7 @@ impl Basic {
         self.mode = TransponderMode::Framed;
         self.host.reset_framer();
         self.transparent = Transparent::default();
-        // Cannot fail to build: one data byte.
-        let ack = Frame::new(local::code::SET_TRANSPONDER_MODE, &[1]).unwrap_or_default();
+        let ack = Reply::Ack.to_frame(cmd::SET_TRANSPONDER_MODE);
         if !self.host.send_frame(&ack) {
             self.supervisor.error(BasicError::HostOverflow);
         }

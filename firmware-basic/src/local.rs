@@ -13,50 +13,21 @@
 //! | 0xC3 get transponder mode | mode |
 //!
 //! 0xB1 answers raw text, not a frame, because that is what pymycobot reads: it decodes the
-//! bytes as UTF-8 and splits them at spaces (a frame would make it raise). A request with a
-//! data length its command does not have is refused with `00`.
+//! bytes as UTF-8 and splits them at spaces (a frame would make it raise). A request that
+//! `protocol_core::command::Request::parse` rejects (wrong length, bad level or mode) is
+//! refused with `00`.
 
 use protocol_core::Frame;
+use protocol_core::command::{CommandError, Reply as ReplyData, Request, cmd, is_basic_local};
 
-use crate::io::{self, BasicIo};
+use crate::io::BasicIo;
 use crate::status::{BasicError, TransponderMode};
-
-/// Command codes the Basic answers itself.
-pub mod code {
-    /// Set a Basic output pin.
-    pub const SET_BASIC_OUTPUT: u8 = 0xA0;
-    /// Read a Basic input pin.
-    pub const GET_BASIC_INPUT: u8 = 0xA1;
-    /// Set the Wi-Fi SSID and password.
-    pub const SET_SSID_PWD: u8 = 0xB0;
-    /// Get the Wi-Fi SSID and password.
-    pub const GET_SSID_PWD: u8 = 0xB1;
-    /// Set the TCP server port.
-    pub const SET_SERVER_PORT: u8 = 0xB2;
-    /// Read the ToF distance sensor.
-    pub const GET_TOF_DISTANCE: u8 = 0xC0;
-    /// Get the Basic's firmware version.
-    pub const GET_BASIC_VERSION: u8 = 0xC1;
-    /// Set the transponder mode.
-    pub const SET_TRANSPONDER_MODE: u8 = 0xC2;
-    /// Get the transponder mode.
-    pub const GET_TRANSPONDER_MODE: u8 = 0xC3;
-}
 
 /// What 0xB1 answers: no network configured, in the text form pymycobot parses.
 pub const NO_WIFI_TEXT: &[u8] = b"ssid:  password: ";
 
-/// Status byte of a command that was carried out.
-const DONE: u8 = 1;
-/// Status byte of a command that was refused.
-const REFUSED: u8 = 0;
 /// Level byte of 0xA1 for a pin that cannot be read (pymycobot decodes it as -1).
 const NO_LEVEL: u8 = 0xFF;
-
-/// True if the Basic answers `cmd` itself.
-pub fn is_local(cmd: u8) -> bool {
-    matches!(cmd, 0xA0 | 0xA1 | 0xB0..=0xB2 | 0xC0..=0xC3)
-}
 
 /// The Basic's answer to one of its own commands.
 #[derive(Debug, PartialEq, Eq)]
@@ -79,17 +50,17 @@ pub(crate) enum Reply {
 }
 
 impl Answer {
-    fn data(cmd: u8, data: &[u8]) -> Self {
+    fn reply(cmd: u8, data: ReplyData) -> Self {
         Self {
-            // Local replies carry at most 2 data bytes, so Frame::new cannot fail.
-            reply: Reply::Frame(Frame::new(cmd, data).unwrap_or_default()),
+            reply: Reply::Frame(data.to_frame(cmd)),
             new_mode: None,
             error: None,
         }
     }
 
+    /// The status reply: `01` done, `00` refused.
     fn status(cmd: u8, done: bool) -> Self {
-        Self::data(cmd, &[if done { DONE } else { REFUSED }])
+        Self::reply(cmd, ReplyData::Byte(u8::from(done)))
     }
 
     fn with_error(mut self, error: BasicError) -> Self {
@@ -105,60 +76,59 @@ pub(crate) fn answer<I: BasicIo>(
     version_x10: u8,
     mode: TransponderMode,
 ) -> Option<Answer> {
-    let cmd = frame.cmd();
-    let answer = match (cmd, frame.data()) {
-        (code::SET_BASIC_OUTPUT, &[pin, level]) => {
-            let high = match level {
-                0 => Some(false),
-                1 => Some(true),
-                _ => None,
-            };
-            match high {
-                _ if !io::is_output_pin(pin) => {
-                    Answer::status(cmd, false).with_error(BasicError::InvalidPin { pin })
-                }
-                Some(high) => Answer::status(cmd, io.set_output(pin, high)),
-                None => Answer::status(cmd, false),
-            }
+    let code = frame.cmd();
+    if !is_basic_local(code) {
+        return None;
+    }
+    let answer = match Request::parse(frame) {
+        Ok(Request::SetBasicOutput { pin, high }) => {
+            Answer::status(code, io.set_output(pin.gpio(), high))
         }
-        (code::GET_BASIC_INPUT, &[pin]) => {
-            let level = if io::is_input_pin(pin) {
-                io.read_input(pin)
-            } else {
-                None
-            };
-            let answer = Answer::data(cmd, &[pin, level.map_or(NO_LEVEL, u8::from)]);
-            if io::is_input_pin(pin) {
-                answer
-            } else {
-                answer.with_error(BasicError::InvalidPin { pin })
-            }
-        }
-        (code::GET_SSID_PWD, _) => Answer {
+        Ok(Request::GetBasicInput { pin }) => match io.read_input(pin.gpio()) {
+            Some(high) => Answer::reply(
+                code,
+                ReplyData::PinLevel {
+                    pin: pin.gpio(),
+                    high,
+                },
+            ),
+            None => pin_unreadable(code, pin.gpio()),
+        },
+        Ok(Request::GetSsidPwd) => Answer {
             reply: Reply::Raw(NO_WIFI_TEXT),
             new_mode: None,
             error: None,
         },
-        (code::SET_SSID_PWD | code::SET_SERVER_PORT, _) => Answer::status(cmd, false),
-        (code::GET_TOF_DISTANCE, &[]) => {
+        Ok(Request::GetTofDistance) => {
             let mm = io
                 .tof_distance_mm()
                 .map_or(-1, |mm| i16::try_from(mm).unwrap_or(i16::MAX));
-            Answer::data(cmd, &mm.to_be_bytes())
+            Answer::reply(code, ReplyData::Int16(mm))
         }
-        (code::GET_BASIC_VERSION, &[]) => Answer::data(cmd, &[version_x10]),
-        (code::SET_TRANSPONDER_MODE, &[mode]) => match TransponderMode::from_code(mode) {
-            Some(new_mode) => Answer {
-                new_mode: Some(new_mode),
-                ..Answer::status(cmd, true)
-            },
-            None => Answer::status(cmd, false),
+        Ok(Request::GetBasicVersion) => Answer::reply(code, ReplyData::Byte(version_x10)),
+        Ok(Request::SetTransponderMode { mode }) => Answer {
+            new_mode: Some(mode),
+            ..Answer::status(code, true)
         },
-        (code::GET_TRANSPONDER_MODE, &[]) => Answer::data(cmd, &[mode.code()]),
-        _ if is_local(cmd) => Answer::status(cmd, false),
-        _ => return None,
+        Ok(Request::GetTransponderMode) => Answer::reply(code, ReplyData::Byte(mode as u8)),
+        Err(CommandError::BadPin(pin)) if code == cmd::GET_BASIC_INPUT => {
+            pin_unreadable(code, pin).with_error(BasicError::InvalidPin { pin })
+        }
+        Err(CommandError::BadPin(pin)) => {
+            Answer::status(code, false).with_error(BasicError::InvalidPin { pin })
+        }
+        // No Wi-Fi (0xB0, 0xB2), a bad level or mode, a wrong length: refused.
+        _ => Answer::status(code, false),
     };
     Some(answer)
+}
+
+/// 0xA1's answer for a pin that cannot be read: the pin, level `FF`.
+fn pin_unreadable(code: u8, pin: u8) -> Answer {
+    let mut data = heapless::Vec::new();
+    // Cannot fail: two bytes fit.
+    let _ = data.extend_from_slice(&[pin, NO_LEVEL]);
+    Answer::reply(code, ReplyData::Raw(data))
 }
 
 #[cfg(test)]

@@ -1,38 +1,8 @@
 //! What the transponder reports about itself: the contents of the Basic's LCD.
 
-/// How the host link is used.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum TransponderMode {
-    /// Host frames are checked, the Basic's own commands answered, the rest forwarded one
-    /// request at a time, and only the matching reply returned (mode 0 of 0xC2).
-    #[default]
-    Framed,
-    /// Raw bytes both ways (mode 1 of 0xC2), for tools that talk to the servos directly. The
-    /// only thing still recognised is the frame `FE FE 03 C2 00 FA`, which returns to framed
-    /// mode.
-    Transparent,
-}
+pub use protocol_core::command::TransponderMode;
 
-impl TransponderMode {
-    /// The mode byte of 0xC2/0xC3.
-    pub fn code(self) -> u8 {
-        match self {
-            Self::Framed => 0,
-            Self::Transparent => 1,
-        }
-    }
-
-    /// The mode for a 0xC2 mode byte; `None` for an unknown mode.
-    pub fn from_code(code: u8) -> Option<Self> {
-        match code {
-            0 => Some(Self::Framed),
-            1 => Some(Self::Transparent),
-            _ => None,
-        }
-    }
-}
-
-/// Whether the Atom answers on the bus.
+/// Whether the Atom answers.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum AtomLink {
     /// Nothing asked of it has been answered yet (booting).
@@ -72,15 +42,16 @@ pub enum BasicError {
 }
 
 /// What the Basic shows on its LCD.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BasicStatus {
     /// The Basic's firmware version, times ten.
     pub version_x10: u8,
-    /// Framed or transparent.
+    /// Framed (host frames checked, own commands answered, the rest forwarded one request at
+    /// a time) or transparent (raw bytes both ways until `FE FE 03 C2 00 FA`).
     pub mode: TransponderMode,
     /// Whether the Atom answers.
     pub atom: AtomLink,
-    /// The Atom's power state from its last 0x12/0x10 answer, if known.
+    /// The Atom's power state from its last 0x10/0x11/0x12 answer, if known.
     pub atom_powered: Option<bool>,
     /// Whether the bus echoes the Basic's transmissions, once known.
     pub echo_heard: Option<bool>,
@@ -92,8 +63,26 @@ pub struct BasicStatus {
     pub replies_forwarded: u32,
     /// Requests the Atom did not answer in time. Wraps.
     pub timeouts: u32,
-    /// Bus transmissions that collided and were repeated. Wraps.
+    /// Bus transmissions that collided (repeated or given up). Wraps.
     pub collisions: u32,
     /// Host bytes dropped in transparent mode because the bus could not take them. Wraps.
     pub transparent_dropped: u32,
+}
+
+impl Default for BasicStatus {
+    fn default() -> Self {
+        Self {
+            version_x10: 0,
+            mode: TransponderMode::Framed,
+            atom: AtomLink::Unknown,
+            atom_powered: None,
+            echo_heard: None,
+            last_error: None,
+            host_frames: 0,
+            replies_forwarded: 0,
+            timeouts: 0,
+            collisions: 0,
+            transparent_dropped: 0,
+        }
+    }
 }

@@ -3,24 +3,13 @@
 //! and turns the forwarder's events into replies for the host and status for the display.
 
 use protocol_core::Frame;
+use protocol_core::command::cmd;
 
 use crate::config::BasicConfig;
 use crate::forwarder::{Event, Origin, Request};
 use crate::host_link::HostLink;
 use crate::io::Buttons;
 use crate::status::{AtomLink, BasicError, BasicStatus};
-
-/// Atom command codes the supervisor sends or watches.
-mod atom_cmd {
-    /// Power on: torque on, servos ready.
-    pub const POWER_ON: u8 = 0x10;
-    /// Power off.
-    pub const POWER_OFF: u8 = 0x11;
-    /// Is powered on: 1 byte.
-    pub const IS_POWERED_ON: u8 = 0x12;
-    /// Release all servos.
-    pub const RELEASE_ALL_SERVOS: u8 = 0x13;
-}
 
 /// The supervisor's state.
 #[derive(Debug)]
@@ -63,7 +52,7 @@ impl Supervisor {
     /// A host request with command `cmd` is about to be forwarded.
     pub(crate) fn on_host_request(&mut self, cmd: u8) {
         self.status.host_frames = self.status.host_frames.wrapping_add(1);
-        if matches!(cmd, atom_cmd::POWER_OFF | atom_cmd::RELEASE_ALL_SERVOS) {
+        if matches!(cmd, cmd::POWER_OFF | cmd::RELEASE_ALL_SERVOS) {
             // The host has taken charge of the arm's power: do not power it on behind its back.
             self.power_on_pending = false;
         }
@@ -88,9 +77,9 @@ impl Supervisor {
         }
         let interval_us = config.probe_interval_us;
         let (cmd, origin) = if self.power_on_pending {
-            (atom_cmd::POWER_ON, Origin::PowerOn)
+            (cmd::POWER_ON, Origin::PowerOn)
         } else if interval_us > 0 && now_us.saturating_sub(self.last_answer_us) >= interval_us {
-            (atom_cmd::IS_POWERED_ON, Origin::Probe)
+            (cmd::IS_POWER_ON, Origin::Probe)
         } else {
             return None;
         };
@@ -116,12 +105,12 @@ impl Supervisor {
                 self.last_answer_us = now_us;
                 let done = reply.data() == [1];
                 match (request.frame.cmd(), reply.data()) {
-                    (atom_cmd::POWER_ON, _) if done => {
+                    (cmd::POWER_ON, _) if done => {
                         status.atom_powered = Some(true);
                         self.power_on_pending = false;
                     }
-                    (atom_cmd::POWER_OFF, _) if done => status.atom_powered = Some(false),
-                    (atom_cmd::IS_POWERED_ON, &[state]) => status.atom_powered = Some(state == 1),
+                    (cmd::POWER_OFF, _) if done => status.atom_powered = Some(false),
+                    (cmd::IS_POWER_ON, &[state]) => status.atom_powered = Some(state == 1),
                     _ => {}
                 }
                 if request.origin == Origin::Host {
