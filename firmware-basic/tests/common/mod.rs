@@ -122,6 +122,26 @@ impl Wire {
         self.txs.drain(..keep_from);
     }
 
+    /// The first time from `from_ns` at which `n` bytes fit on the wire without touching
+    /// traffic already scheduled, with the quiet time a polite station leaves around it.
+    pub fn free_slot(&self, from_ns: u64, n: usize) -> u64 {
+        let quiet_ns = timing::BUS_QUIET_BEFORE_SEND_US * 1_000;
+        let mut start = from_ns;
+        loop {
+            let end = start + n as u64 * BUS_BYTE_NS;
+            let clash = self
+                .txs
+                .iter()
+                .filter(|t| t.start_ns < end + quiet_ns && start < t.end_ns() + quiet_ns)
+                .map(Tx::end_ns)
+                .max();
+            match clash {
+                Some(busy_until) => start = busy_until + quiet_ns,
+                None => return start,
+            }
+        }
+    }
+
     /// Time the wire has been silent, in ns (0 while somebody transmits).
     pub fn quiet_ns(&self) -> u64 {
         self.now_ns.saturating_sub(self.last_end_ns)
@@ -371,7 +391,7 @@ impl Rig {
         for (at, frame) in frames {
             self.atom_got.push((at, frame.clone()));
             if let Some(reply) = (self.atom)(&frame) {
-                let start = at + self.atom_delay_ns;
+                let start = self.wire().free_slot(at + self.atom_delay_ns, reply.len());
                 self.wire().inject(start, &reply);
             }
         }
