@@ -20,6 +20,8 @@ mod robot;
 pub mod servo;
 pub mod wire;
 
-pub use robot::{HostLink, POLL_PERIOD_NS, RobotConfig, SERVO_IDS, SimBasicIo, VirtualRobot};
+pub use robot::{
+    AskError, HostLink, POLL_PERIOD_NS, RobotConfig, SERVO_IDS, SimBasicIo, VirtualRobot,
+};
 pub use servo::{Faults, ServoStats, SimServo};
 pub use wire::{Bus, BusByte, SerialLine, StationId};

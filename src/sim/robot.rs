@@ -3,7 +3,9 @@
 
 use firmware_atom::{Atom, AtomConfig, RecordingIo};
 use firmware_basic::{Basic, BasicConfig, BasicIo, Buttons};
+use protocol_core::command::{Reply, ReplyError, Request};
 use protocol_core::timing::{HOST_BAUD, HOST_REPLY_DEADLINE_US};
+use protocol_core::units::{Centideg, Steps};
 use protocol_core::{Frame, FrameDecoder};
 
 use super::servo::SimServo;
@@ -140,6 +142,20 @@ struct BasicBoard {
 struct SimulatedServo {
     station: StationId,
     servo: SimServo,
+}
+
+/// Why [`VirtualRobot::ask`] got no usable answer.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum AskError {
+    /// No complete frame came back within pymycobot's reply deadline (0.5 s).
+    NoReply,
+    /// A frame came back for another command (pymycobot ignores it).
+    WrongCommand {
+        /// The CMD byte of the frame that came back.
+        cmd: u8,
+    },
+    /// The frame had the right command but not the shape the request expects.
+    BadReply(ReplyError),
 }
 
 /// Which USB port a host talks to.
@@ -350,6 +366,49 @@ impl VirtualRobot {
             }
         }
         None
+    }
+
+    /// Sends `request` on the Basic's USB port like pymycobot does (one try) and returns the
+    /// typed reply.
+    pub fn ask(&mut self, request: &Request) -> Result<Reply, AskError> {
+        self.ask_on(HostLink::Basic, request)
+    }
+
+    /// Like [`VirtualRobot::ask`] on any host link.
+    pub fn ask_on(&mut self, link: HostLink, request: &Request) -> Result<Reply, AskError> {
+        let frame = request.to_frame();
+        let reply = self.transact_on(link, &frame).ok_or(AskError::NoReply)?;
+        if reply.cmd() != frame.cmd() {
+            return Err(AskError::WrongCommand { cmd: reply.cmd() });
+        }
+        Reply::parse(request.reply_kind(), &reply).map_err(AskError::BadReply)
+    }
+
+    /// Runs until `done(self)` holds (checked every millisecond of virtual time) or `timeout_us`
+    /// passes; returns whether it held.
+    pub fn run_until_true(&mut self, timeout_us: u64, mut done: impl FnMut(&Self) -> bool) -> bool {
+        let deadline = self.now_us() + timeout_us;
+        while !done(self) {
+            if self.now_us() >= deadline {
+                return false;
+            }
+            self.run_for(1_000);
+        }
+        true
+    }
+
+    /// The joint angles the servos' shafts are really at (present positions converted with the
+    /// Atom's joint signs): what a protractor on the arm would read.
+    pub fn measured_angles(&self) -> [Centideg; 6] {
+        let config = self.atom.config();
+        std::array::from_fn(|j| {
+            let position = config
+                .servo_ids
+                .get(j)
+                .and_then(|&id| self.servo(id))
+                .map_or(2048, |s| s.present_position());
+            config.steps_to_angle(j, Steps(position as i16))
+        })
     }
 
     /// The simulated servo with bus id `id` (its present register 5).

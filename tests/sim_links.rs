@@ -1,0 +1,86 @@
+//! The host talks to the arm in the other ways users have: straight into the Atom's own USB
+//! port (with or without a Basic), and to the Basic's own pins.
+
+mod sim_support;
+
+use open_mycobot::sim::{HostLink, RobotConfig};
+use protocol_core::command::{BasicInputPin, BasicOutputPin, Reply, Request};
+use sim_support::*;
+
+#[test]
+fn without_a_basic_the_atom_usb_port_drives_the_arm() {
+    let mut robot = booted(RobotConfig {
+        with_basic: false,
+        ..RobotConfig::default()
+    });
+    assert_eq!(
+        ask_on(&mut robot, HostLink::AtomUsb, Request::IsPowerOn),
+        Reply::Byte(1)
+    );
+    let target = degrees([-15.0, 25.0, -35.0, 45.0, -55.0, 65.0]);
+    assert_eq!(
+        ask_on(
+            &mut robot,
+            HostLink::AtomUsb,
+            Request::SendAngles {
+                angles: target,
+                speed: speed(100),
+            }
+        ),
+        Reply::Ack
+    );
+    assert!(robot.run_until_true(MOTION_TIMEOUT_US, |r| {
+        r.measured_angles()
+            .iter()
+            .zip(target)
+            .all(|(a, t)| (a.0 - t.0).abs() <= ANGLE_TOLERANCE)
+    }));
+    let Reply::Angles(reported) = ask_on(&mut robot, HostLink::AtomUsb, Request::GetAngles) else {
+        panic!("no angles");
+    };
+    assert_angles_near(reported, target, "get_angles over the Atom's USB");
+    // Nothing talks to a Basic that is not there.
+    assert!(robot.ask(&Request::IsPowerOn).is_err());
+}
+
+#[test]
+fn both_usb_ports_work_side_by_side() {
+    let mut robot = arm();
+    for _ in 0..3 {
+        assert_eq!(ask(&mut robot, Request::IsPowerOn), Reply::Byte(1));
+        assert_eq!(
+            ask_on(&mut robot, HostLink::AtomUsb, Request::IsPowerOn),
+            Reply::Byte(1)
+        );
+    }
+    assert_silent_for(&mut robot, HostLink::Basic, 200_000);
+    assert_silent_for(&mut robot, HostLink::AtomUsb, 0);
+}
+
+#[test]
+fn the_basic_answers_its_own_pins() {
+    let mut robot = arm();
+    let pump = BasicOutputPin::new(5).expect("pin 5");
+    let reply = ask(
+        &mut robot,
+        Request::SetBasicOutput {
+            pin: pump,
+            high: true,
+        },
+    );
+    assert!(matches!(reply, Reply::Ack | Reply::Raw(_)), "{reply:?}");
+    assert_eq!(robot.basic_io_mut().expect("basic").outputs, [false, true]);
+    robot.basic_io_mut().expect("basic").inputs = [false, true];
+    let pin = BasicInputPin::new(36).expect("pin 36");
+    assert_eq!(
+        ask(&mut robot, Request::GetBasicInput { pin }),
+        Reply::PinLevel {
+            pin: 36,
+            high: true
+        }
+    );
+    assert!(matches!(
+        ask(&mut robot, Request::GetBasicVersion),
+        Reply::Byte(v) if v > 0
+    ));
+}

@@ -1,0 +1,213 @@
+//! A user drives the virtual arm through the Basic's USB port, the way pymycobot does, and
+//! checks that it moves exactly where told and reports what it does.
+
+mod sim_support;
+
+use open_mycobot::sim::{HostLink, RobotConfig};
+use protocol_core::Frame;
+use protocol_core::command::{ErrorCode, JointId, Reply, Request, cmd};
+use protocol_core::units::Centideg;
+use sim_support::*;
+
+#[test]
+fn a_fresh_arm_is_powered_and_reports_zero_angles() {
+    let mut robot = arm();
+    assert_eq!(ask(&mut robot, Request::IsPowerOn), Reply::Byte(1));
+    assert_eq!(get_angles(&mut robot), [Centideg(0); 6]);
+    assert_eq!(ask(&mut robot, Request::IsMoving), Reply::Byte(0));
+    assert_eq!(
+        ask(&mut robot, Request::AreAllServosEnabled),
+        Reply::Byte(1)
+    );
+    assert!(robot.servos().all(|s| s.torque_enabled()));
+}
+
+#[test]
+fn send_angles_moves_every_joint_exactly_where_told() {
+    let mut robot = arm();
+    let target = degrees([30.0, -45.0, 60.0, -90.0, 45.0, 120.0]);
+    ack(
+        &mut robot,
+        Request::SendAngles {
+            angles: target,
+            speed: speed(80),
+        },
+    );
+    robot.run_for(100_000);
+    assert_eq!(ask(&mut robot, Request::IsMoving), Reply::Byte(1));
+    let halfway = get_angles(&mut robot);
+    assert_ne!(halfway, target, "a move takes time");
+    wait_until_stopped(&mut robot);
+    assert_angles_near(robot.measured_angles(), target, "shafts");
+    assert_angles_near(get_angles(&mut robot), target, "get_angles");
+}
+
+#[test]
+fn send_angle_moves_one_joint_and_leaves_the_others() {
+    let mut robot = arm();
+    let joint = JointId::new(5).expect("joint 5");
+    ack(
+        &mut robot,
+        Request::SendAngle {
+            joint,
+            angle: Centideg(-7_250),
+            speed: speed(50),
+        },
+    );
+    wait_until_stopped(&mut robot);
+    let expected = degrees([0.0, 0.0, 0.0, 0.0, -72.5, 0.0]);
+    assert_angles_near(robot.measured_angles(), expected, "shafts");
+    assert_angles_near(get_angles(&mut robot), expected, "get_angles");
+}
+
+#[test]
+fn a_slower_speed_takes_longer() {
+    let duration_at = |percent: u8| {
+        let mut robot = arm();
+        let start = robot.now_us();
+        ack(
+            &mut robot,
+            Request::SendAngles {
+                angles: degrees([60.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+                speed: speed(percent),
+            },
+        );
+        let target = degrees([60.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        assert!(
+            robot.run_until_true(MOTION_TIMEOUT_US, |r| {
+                (r.measured_angles()[0].0 - target[0].0).abs() <= ANGLE_TOLERANCE
+            }),
+            "joint 1 never arrived at speed {percent}"
+        );
+        robot.now_us() - start
+    };
+    let fast = duration_at(100);
+    let slow = duration_at(20);
+    assert!(slow > 2 * fast, "20 % took {slow} us, 100 % took {fast} us");
+}
+
+#[test]
+fn stop_halts_a_move_where_it_is() {
+    let mut robot = arm();
+    let target = degrees([90.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    ack(
+        &mut robot,
+        Request::SendAngles {
+            angles: target,
+            speed: speed(10),
+        },
+    );
+    robot.run_for(500_000);
+    ack(&mut robot, Request::Stop);
+    robot.run_for(1_000_000);
+    let stopped_at = robot.measured_angles();
+    assert!(
+        stopped_at[0].0 > 0 && stopped_at[0].0 < 9_000 - 500,
+        "{stopped_at:?}"
+    );
+    assert_eq!(ask(&mut robot, Request::IsMoving), Reply::Byte(0));
+    robot.run_for(1_000_000);
+    assert_eq!(robot.measured_angles(), stopped_at, "stays stopped");
+    assert_angles_near(get_angles(&mut robot), stopped_at, "get_angles after stop");
+}
+
+#[test]
+fn power_off_releases_the_servos_and_power_on_holds_them_again() {
+    let mut robot = arm();
+    ack(&mut robot, Request::PowerOff);
+    robot.run_for(20_000);
+    assert!(robot.servos().take(6).all(|s| !s.torque_enabled()));
+    assert_eq!(ask(&mut robot, Request::IsPowerOn), Reply::Byte(0));
+    ack(&mut robot, Request::PowerOn);
+    robot.run_for(20_000);
+    assert!(robot.servos().take(6).all(|s| s.torque_enabled()));
+    assert_eq!(ask(&mut robot, Request::IsPowerOn), Reply::Byte(1));
+}
+
+#[test]
+fn a_released_arm_reports_where_a_hand_moved_it() {
+    let mut robot = arm();
+    ack(&mut robot, Request::ReleaseAllServos { undamped: None });
+    robot.run_for(20_000);
+    // About 40 degrees on joint 2, -20 on joint 4.
+    robot
+        .servo_mut(2)
+        .expect("servo 2")
+        .move_by_hand(2048 + 455);
+    robot
+        .servo_mut(4)
+        .expect("servo 4")
+        .move_by_hand(2048 - 228);
+    robot.run_for(100_000);
+    let reported = get_angles(&mut robot);
+    assert_angles_near(reported, robot.measured_angles(), "get_angles in free mode");
+    assert!((reported[1].0 - 4_000).abs() < 20, "{reported:?}");
+    assert!((reported[3].0 + 2_000).abs() < 20, "{reported:?}");
+}
+
+#[test]
+fn an_angle_beyond_the_joint_limit_is_refused_and_nothing_moves() {
+    let mut robot = arm();
+    // Joint 1 to 200 degrees at 50 %: pymycobot would refuse it; a raw client may not.
+    let frame = Frame::new(cmd::SEND_ANGLE, &[1, 0x4E, 0x20, 50]).expect("frame");
+    let replies = frames_within(&mut robot, &frame, 100_000);
+    assert_eq!(replies.len(), 1, "exactly one reply: {replies:?}");
+    assert_eq!(replies[0].cmd(), cmd::SEND_ANGLE);
+    robot.run_for(1_000_000);
+    assert_eq!(robot.measured_angles(), [Centideg(0); 6]);
+    assert_eq!(
+        ask(&mut robot, Request::GetErrorInfo),
+        Reply::Byte(ErrorCode::JointLimit(JointId::new(1).expect("joint 1")).code())
+    );
+}
+
+#[test]
+fn encoders_go_where_told_and_read_back() {
+    let mut robot = arm();
+    let target = [1800, 2300, 2048, 1500, 2600, 3000].map(steps);
+    ack(
+        &mut robot,
+        Request::SetEncoders {
+            encoders: target,
+            speed: speed(70),
+        },
+    );
+    wait_until_stopped(&mut robot);
+    let Reply::Encoders(read) = ask(&mut robot, Request::GetEncoders) else {
+        panic!("get_encoders gave no encoders");
+    };
+    for (j, (r, t)) in read.iter().zip(target).enumerate() {
+        assert!((r.0 - t.0).abs() <= 1, "joint {}: {r:?} vs {t:?}", j + 1);
+        let servo = robot.servo(j as u8 + 1).expect("servo");
+        assert!((i32::from(servo.present_position()) - i32::from(t.0)).abs() <= 1);
+    }
+}
+
+#[test]
+fn every_request_gets_exactly_one_reply_and_never_its_echo() {
+    let mut robot = booted(RobotConfig::default());
+    let requests = [
+        Request::GetSystemVersion,
+        Request::IsPowerOn,
+        Request::GetAngles,
+        Request::GetEncoders,
+        Request::SendAngles {
+            angles: degrees([5.0, 5.0, 5.0, 5.0, 5.0, 5.0]),
+            speed: speed(50),
+        },
+        Request::IsMoving,
+        Request::GetServoTemps,
+        Request::GetServoVoltages,
+        Request::GetErrorInfo,
+        Request::GetBasicVersion,
+        Request::GetCoords,
+    ];
+    for request in requests {
+        let frame = request.to_frame();
+        let replies = frames_within(&mut robot, &frame, 200_000);
+        assert_eq!(replies.len(), 1, "{request:?} got {replies:?}");
+        assert_eq!(replies[0].cmd(), frame.cmd(), "{request:?}");
+        assert_ne!(replies[0], frame, "{request:?} was echoed");
+        assert_silent_for(&mut robot, HostLink::Basic, 300_000);
+    }
+}
