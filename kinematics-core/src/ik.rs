@@ -26,9 +26,18 @@ use crate::transform::{LEN_PER_TENTH_MM, Len, Transform};
 /// poses read at the stretched or shoulder-singular configurations (the zero pose) just outside.
 const REACH_TOLERANCE: Len = 2 * LEN_PER_TENTH_MM;
 
-/// |sin t5| (Q30, 6e-5, i.e. q5 within 0.0035 deg of +-90) below which the wrist is singular and
-/// t6 keeps its seed value; the orientation error this causes is below 0.004 deg.
-const WRIST_SINGULAR_SIN: i64 = 1 << 16;
+/// How far (2 um) beyond reach a branch may be and still count as exact: the fixed-point
+/// error of a consistent target. Branches clamped by more are approximate and chosen only when
+/// no exact branch fits the limits.
+const EXACT_SLACK: Len = 2 * LEN_PER_TENTH_MM / 100;
+
+/// |sin t5| (Q30, 2.4e-4, i.e. q5 within 0.014 deg of +-90) below which the wrist is singular
+/// and t6 keeps its seed value. The orientation error this causes is at most |sin t5| times the
+/// change of t6 (0.044 deg if the seed is opposite, far less when it is the current angle), and
+/// it is what lets a pose read at the singularity and rounded to the wire's 0.01 deg (an
+/// orientation noise of 1e-4 rad, which would swing an exact t6 arbitrarily and move the frame-4
+/// origin on a d5-radius circle) be solved back to where it was read.
+const WRIST_SINGULAR_SIN: i64 = 1 << 18;
 
 /// Wrist points farther than this (2 m) from the base axes are unreachable without further
 /// arithmetic (and keep every square inside `i64`).
@@ -37,8 +46,23 @@ const MAX_WRIST_COORD: Len = 20_000 * LEN_PER_TENTH_MM;
 /// The most branches: shoulder x wrist x elbow.
 pub(crate) const MAX_BRANCHES: usize = 8;
 
-/// DH angles of each branch that exists, indexed shoulder * 4 + wrist * 2 + elbow.
-pub(crate) type Branches = [Option<[Angle; 6]>; MAX_BRANCHES];
+/// One IK solution in DH angles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Branch {
+    /// DH angles theta 1..6.
+    pub theta: [Angle; 6],
+    /// False if the target was beyond reach by more than [`EXACT_SLACK`] and was clamped.
+    pub exact: bool,
+}
+
+/// Each branch that exists, indexed shoulder * 4 + wrist * 2 + elbow.
+pub(crate) type Branches = [Option<Branch>; MAX_BRANCHES];
+
+/// Whether `low <= sqrt(v) <= high` (lengths), with `low` clamped at zero.
+fn within(v: i64, low: Len, high: Len) -> bool {
+    let low = low.max(0);
+    v >= low * low && v <= high * high
+}
 
 /// All IK branches for the flange pose `target` (base frame). `seed_theta6` is used for t6 at
 /// the wrist singularity.
@@ -58,10 +82,10 @@ pub(crate) fn solve(
     }
     let [wx, wy, _] = w;
     let r2 = wx * wx + wy * wy;
-    let inner = (d4 - REACH_TOLERANCE).max(0);
-    if r2 < inner * inner {
+    if !within(r2, d4 - REACH_TOLERANCE, 2 * MAX_WRIST_COORD) {
         return Err(IkError::Unreachable);
     }
+    let shoulder_exact = within(r2, d4 - EXACT_SLACK, 2 * MAX_WRIST_COORD);
     let psi = atan2(wy, wx);
     let phi = atan2(sqrt(r2 - d4 * d4), d4);
 
@@ -90,11 +114,10 @@ pub(crate) fn solve(
             let t234 = atan2(t14.rotation.at(1, 0), t14.rotation.at(0, 0));
             let [ex, ey, _] = t14.position;
             let l2 = ex * ex + ey * ey;
-            let outer = s_len + REACH_TOLERANCE;
-            let inner = (d_len - REACH_TOLERANCE).max(0);
-            if l2 > outer * outer || l2 < inner * inner {
+            if !within(l2, d_len - REACH_TOLERANCE, s_len + REACH_TOLERANCE) {
                 continue;
             }
+            let exact = shoulder_exact && within(l2, d_len - EXACT_SLACK, s_len + EXACT_SLACK);
             if l2 == 0 {
                 degenerate = true;
                 continue;
@@ -108,7 +131,10 @@ pub(crate) fn solve(
                 let t2 = atan2(ey, ex).sub(atan2(mul(a3, s3), a2 + mul(a3, c3)));
                 let t4 = t234.sub(t2).sub(t3);
                 if let Some(slot) = out.get_mut(shoulder * 4 + wrist * 2 + elbow) {
-                    *slot = Some([t1, t2, t3, t4, t5, t6]);
+                    *slot = Some(Branch {
+                        theta: [t1, t2, t3, t4, t5, t6],
+                        exact,
+                    });
                 }
             }
         }

@@ -154,6 +154,51 @@ impl Kinematics {
         target: &Transform,
         seed: &JointAngles,
     ) -> Result<JointAngles, IkError> {
+        let seed_theta6 = self.links.theta(5, seed.0[5]);
+        let branches = ik::solve(&self.links, &self.flange_of(target), seed_theta6)?;
+        // Exact branches first, then clamped ones (target just out of reach); nearest the seed.
+        branches
+            .iter()
+            .flatten()
+            .filter_map(|b| Some((self.in_limits_near(&b.theta, seed)?, !b.exact)))
+            .min_by_key(|((_, distance), clamped)| (*clamped, *distance))
+            .map(|((q, _), _)| q)
+            .ok_or(IkError::OutsideLimits)
+    }
+
+    /// Every branch for `target` as joint angles wrapped into the limits near `seed` (`None` for
+    /// a branch that does not exist or does not fit the limits), indexed
+    /// shoulder * 4 + wrist * 2 + elbow. Branches that reach the target only by clamping it
+    /// (up to 0.2 mm beyond reach) are listed only when no branch reaches it exactly.
+    pub fn inverse_all(
+        &self,
+        target: &Pose,
+        seed: &JointAngles,
+    ) -> Result<[Option<JointAngles>; 8], IkError> {
+        self.inverse_all_transform(&Transform::from_pose(target), seed)
+    }
+
+    /// [`Kinematics::inverse_all`] for a full-precision target transform.
+    pub fn inverse_all_transform(
+        &self,
+        target: &Transform,
+        seed: &JointAngles,
+    ) -> Result<[Option<JointAngles>; 8], IkError> {
+        let branches = ik::solve(
+            &self.links,
+            &self.flange_of(target),
+            self.links.theta(5, seed.0[5]),
+        )?;
+        let any_exact = branches.iter().flatten().any(|b| b.exact);
+        Ok(branches.map(|b| {
+            b.filter(|b| b.exact || !any_exact)
+                .and_then(|b| self.in_limits_near(&b.theta, seed))
+                .map(|(q, _)| q)
+        }))
+    }
+
+    /// The flange pose (base frame) that puts the end at `target` (selected frames).
+    fn flange_of(&self, target: &Transform) -> Transform {
         let mut flange = *target;
         if let Some((_, world_inv)) = &self.world {
             flange = world_inv.then(&flange);
@@ -161,37 +206,7 @@ impl Kinematics {
         if let Some((_, tool_inv)) = &self.tool {
             flange = flange.then(tool_inv);
         }
-        let seed_theta6 = self.links.theta(5, seed.0[5]);
-        let branches = ik::solve(&self.links, &flange, seed_theta6)?;
-        branches
-            .iter()
-            .flatten()
-            .filter_map(|theta| self.in_limits_near(theta, seed))
-            .min_by_key(|(_, distance)| *distance)
-            .map(|(q, _)| q)
-            .ok_or(IkError::OutsideLimits)
-    }
-
-    /// Every branch for `target` as joint angles wrapped into the limits near `seed` (`None` for
-    /// a branch that does not exist or does not fit the limits), indexed
-    /// shoulder * 4 + wrist * 2 + elbow.
-    pub fn inverse_all(
-        &self,
-        target: &Pose,
-        seed: &JointAngles,
-    ) -> Result<[Option<JointAngles>; 8], IkError> {
-        let mut flange = Transform::from_pose(target);
-        if let Some((_, world_inv)) = &self.world {
-            flange = world_inv.then(&flange);
-        }
-        if let Some((_, tool_inv)) = &self.tool {
-            flange = flange.then(tool_inv);
-        }
-        let branches = ik::solve(&self.links, &flange, self.links.theta(5, seed.0[5]))?;
-        Ok(branches.map(|b| {
-            b.and_then(|theta| self.in_limits_near(&theta, seed))
-                .map(|(q, _)| q)
-        }))
+        flange
     }
 
     /// DH angles `theta` as protocol angles wrapped into the limits nearest `seed`, with the
