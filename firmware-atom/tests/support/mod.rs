@@ -190,6 +190,8 @@ pub struct FakeBus {
     pub instructions: u64,
     /// Times at which each servo's state block was read (servo index, time).
     pub state_reads: Vec<(usize, u64)>,
+    /// Every byte on the wire: (time it ends, who sent it: 'A' Atom, 'H' host, 'S' servo).
+    pub trace: Vec<(u64, char, u8)>,
 }
 
 impl FakeBus {
@@ -207,6 +209,7 @@ impl FakeBus {
             replies: Vec::new(),
             instructions: 0,
             state_reads: Vec::new(),
+            trace: Vec::new(),
         }
     }
 
@@ -230,6 +233,7 @@ impl FakeBus {
         for &b in bytes {
             t += BYTE_US;
             self.to_atom.push_back(Timed { at_us: t, byte: b });
+            self.trace.push((t, 'H', b));
         }
         self.wire_free_us = self.wire_free_us.max(t);
         self.sort();
@@ -301,6 +305,7 @@ impl FakeBus {
                         }
                         for b in bytes {
                             answer_at += BYTE_US;
+                            self.trace.push((answer_at, 'S', b));
                             self.to_atom.push_back(Timed {
                                 at_us: answer_at,
                                 byte: b,
@@ -336,6 +341,7 @@ impl BytePort for FakeBus {
         let mut t = self.now_us.max(self.atom_tx_end_us);
         for &b in bytes {
             t += BYTE_US;
+            self.trace.push((t, 'A', b));
             if self.echo {
                 self.to_atom.push_back(Timed { at_us: t, byte: b });
             }

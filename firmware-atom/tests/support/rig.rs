@@ -72,19 +72,44 @@ impl Rig {
     /// frame with the time from the request's last byte to the reply's last byte, or `None`
     /// after 600 ms.
     pub fn request_timed(&mut self, frame: &Frame) -> Option<(Frame, u64)> {
-        while self.bus.quiet_us() < BUS_QUIET_BEFORE_SEND_US {
-            self.tick();
-        }
         let seen = self.bus.replies.len();
-        let end = self.bus.send_frame(frame);
+        let mut first_end = None;
         let deadline = self.now() + 600_000;
-        while self.now() < deadline {
-            self.tick();
-            if let Some(r) = self.bus.replies.get(seen) {
-                return Some((r.frame.clone(), r.end_us.saturating_sub(end)));
+        'attempt: while self.now() < deadline {
+            while self.bus.quiet_us() < BUS_QUIET_BEFORE_SEND_US {
+                self.tick();
+            }
+            let start = self.now();
+            let end = self.bus.send_frame(frame);
+            first_end.get_or_insert(end);
+            while self.now() < deadline {
+                self.tick();
+                if self.now() <= end + TICK_US && self.atom_talked_between(start, end) {
+                    // Both started on the same quiet wire: the real Basic sees its echo
+                    // differ and sends again once the wire is quiet (the fake does not garble
+                    // overlapping bytes, so the rig plays that part).
+                    while self.now() <= end + 2 * TICK_US {
+                        self.tick();
+                    }
+                    continue 'attempt;
+                }
+                if let Some(r) = self.bus.replies.get(seen) {
+                    let since = first_end.unwrap_or(end);
+                    return Some((r.frame.clone(), r.end_us.saturating_sub(since)));
+                }
             }
         }
         None
+    }
+
+    /// True if the Atom transmitted while the host's frame was on the wire (a collision).
+    fn atom_talked_between(&self, start: u64, end: u64) -> bool {
+        self.bus
+            .trace
+            .iter()
+            .rev()
+            .take(256)
+            .any(|&(t, who, _)| who == 'A' && t > start && t <= end + super::BYTE_US)
     }
 
     pub fn request(&mut self, frame: &Frame) -> Option<Frame> {

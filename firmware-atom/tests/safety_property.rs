@@ -1,0 +1,122 @@
+//! Property: whatever arrives from the host (valid commands, out-of-range values, garbage,
+//! truncated frames), the Atom never panics and never sends a servo a goal outside the joint
+//! limits or the gripper range.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
+
+mod support;
+
+use firmware_atom::config::DEFAULT_LIMITS;
+use firmware_atom::{AtomConfig, JointLimit};
+use proptest::prelude::*;
+use protocol_core::Frame;
+use protocol_core::units::Steps;
+use support::rig::Rig;
+
+/// Commands a fuzzer should hit often: motion, jog, encoders, servo data, gripper, frames.
+/// Joint limits (0x4C/0x4D) are left out so the limits stay the defaults checked below.
+const COMMANDS: &[u8] = &[
+    0x05, 0x10, 0x11, 0x13, 0x16, 0x1A, 0x20, 0x21, 0x22, 0x23, 0x24, 0x25, 0x26, 0x28, 0x29, 0x2A,
+    0x30, 0x31, 0x32, 0x33, 0x34, 0x3A, 0x3C, 0x3E, 0x52, 0x53, 0x54, 0x55, 0x56, 0x57, 0x66, 0x67,
+    0x68, 0x81, 0x83, 0x85, 0x87, 0x89, 0x8D,
+];
+
+#[derive(Clone, Debug)]
+enum Input {
+    /// A frame with a known command code and arbitrary data.
+    Command(u8, Vec<u8>),
+    /// Arbitrary bytes (noise, half frames).
+    Garbage(Vec<u8>),
+}
+
+fn be(values: &[i16]) -> Vec<u8> {
+    values.iter().flat_map(|v| v.to_be_bytes()).collect()
+}
+
+/// Well-formed requests whose values reach the goal path: encoders anywhere in 0..=4096,
+/// angles beyond every limit, raw goal-register writes.
+fn structured() -> impl Strategy<Value = Input> {
+    let encoders = prop::array::uniform6(0i16..=4096);
+    let angles = prop::array::uniform6(-20_000i16..20_000);
+    prop_oneof![
+        (encoders.clone(), prop::array::uniform6(0i16..6000)).prop_map(|(e, s)| {
+            let mut d = be(&e);
+            d.extend(be(&s));
+            Input::Command(0x3E, d)
+        }),
+        (encoders, 1u8..=100).prop_map(|(e, s)| {
+            let mut d = be(&e);
+            d.push(s);
+            Input::Command(0x3C, d)
+        }),
+        (angles, 1u8..=100).prop_map(|(a, s)| {
+            let mut d = be(&a);
+            d.push(s);
+            Input::Command(0x22, d)
+        }),
+        (
+            1u8..=7,
+            prop::sample::select(vec![40u8, 41, 42, 43]),
+            any::<u16>()
+        )
+            .prop_map(|(id, addr, v)| {
+                let mut d = vec![id, addr];
+                d.extend(v.to_be_bytes());
+                d.push(1);
+                Input::Command(0x52, d)
+            }),
+        (1u8..=7, 0i16..=4096, 1u8..=100).prop_map(|(id, e, s)| {
+            let mut d = vec![id];
+            d.extend(be(&[e]));
+            d.push(s);
+            Input::Command(0x3A, d)
+        }),
+        (0u8..=100, 1u8..=100).prop_map(|(v, s)| Input::Command(0x67, vec![v, s])),
+    ]
+}
+
+fn input() -> impl Strategy<Value = Input> {
+    prop_oneof![
+        3 => (prop::sample::select(COMMANDS), prop::collection::vec(any::<u8>(), 0..26))
+            .prop_map(|(c, d)| Input::Command(c, d)),
+        3 => structured(),
+        1 => prop::collection::vec(any::<u8>(), 0..24).prop_map(Input::Garbage),
+    ]
+}
+
+fn within(limit: &JointLimit, steps: i16, config: &AtomConfig, j: usize) -> bool {
+    let angle = config.steps_to_angle(j, Steps(steps));
+    (0..4096).contains(&steps) && limit.contains(angle)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, .. ProptestConfig::default() })]
+
+    #[test]
+    fn no_input_sends_an_out_of_limit_goal(inputs in prop::collection::vec(input(), 1..24)) {
+        let config = AtomConfig { powered_at_boot: true, ..AtomConfig::default() };
+        let mut rig = Rig::with(config, true);
+        for input in &inputs {
+            match input {
+                Input::Command(cmd, data) => {
+                    if let Some(frame) = Frame::new(*cmd, data) {
+                        rig.bus.send_frame(&frame);
+                    }
+                }
+                Input::Garbage(bytes) => {
+                    rig.bus.send_raw(bytes);
+                }
+            }
+            rig.run_ms(3);
+        }
+        rig.run_ms(100);
+        for (j, (servo, limit)) in rig.bus.servos.iter().zip(&DEFAULT_LIMITS).enumerate() {
+            for &g in &servo.goals {
+                prop_assert!(within(limit, g, &config, j), "joint {} goal {}", j + 1, g);
+            }
+        }
+        let (closed, open) = (config.gripper.closed.0, config.gripper.open.0);
+        for &g in &rig.bus.servos[6].goals {
+            prop_assert!((closed.min(open)..=closed.max(open)).contains(&g), "gripper goal {}", g);
+        }
+    }
+}
