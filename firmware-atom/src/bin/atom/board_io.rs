@@ -118,8 +118,7 @@ impl AtomIo for BoardIo<'_> {
             return Some(self.button.is_high());
         }
         let (user, _) = self.user_pin(pin)?;
-        // The input buffer stays on in every mode, so an output reads back its own level.
-        user.gpio.set_input_enable(true);
+        // The input buffer is on in every mode (`new`), so an output reads back its level.
         Some(user.gpio.is_high())
     }
 
