@@ -191,16 +191,18 @@ pub struct HostPort {
 }
 
 impl HostPort {
-    /// Queues `bytes` from the host, back to back after whatever is queued, from `now`.
-    pub fn send(&mut self, bytes: &[u8]) {
-        let mut start = self
+    /// Queues `bytes` from the host, back to back after whatever is queued, from `now`;
+    /// returns when the last of them has arrived, in ns.
+    pub fn send(&mut self, bytes: &[u8]) -> u64 {
+        let mut end = self
             .to_basic
             .back()
             .map_or(self.now_ns, |&(end, _)| end.max(self.now_ns));
         for &b in bytes {
-            start += HOST_BYTE_NS;
-            self.to_basic.push_back((start, b));
+            end += HOST_BYTE_NS;
+            self.to_basic.push_back((end, b));
         }
+        end
     }
 
     /// The bytes the Basic sent to the host so far.
@@ -300,6 +302,8 @@ pub struct Rig {
     atom_decoder: FrameDecoder,
     /// Frames the Atom received intact, with the time (ns) their last byte ended.
     pub atom_got: Vec<(u64, Frame)>,
+    /// The Atom's replies: when each started on the wire (ns) and its bytes.
+    pub atom_sent: Vec<(u64, Vec<u8>)>,
     /// How the Atom answers.
     pub atom: Responder,
     /// Time from the end of a request to the start of the Atom's answer, ns.
@@ -321,6 +325,7 @@ impl Rig {
             step_ns: 1_000,
             atom_decoder: FrameDecoder::new(),
             atom_got: Vec::new(),
+            atom_sent: Vec::new(),
             atom: ack_everything(),
             atom_delay_ns: 200_000,
             atom_last_rx_ns: 0,
@@ -393,6 +398,7 @@ impl Rig {
             if let Some(reply) = (self.atom)(&frame) {
                 let start = self.wire().free_slot(at + self.atom_delay_ns, reply.len());
                 self.wire().inject(start, &reply);
+                self.atom_sent.push((start, reply));
             }
         }
     }
