@@ -482,3 +482,73 @@ impl VirtualRobot {
         &mut self.bus
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use protocol_core::command::{Reply, Request};
+    use protocol_core::timing::wire_time_us;
+
+    #[test]
+    fn time_only_moves_forward_and_exactly_as_asked() {
+        let mut robot = VirtualRobot::new(RobotConfig::default());
+        robot.run_for(1_234);
+        assert_eq!(robot.now_us(), 1_234);
+        robot.run_until(1_000);
+        assert_eq!(robot.now_us(), 1_234, "the past is a no-op");
+        robot.run_until(5_000);
+        assert_eq!(robot.now_us(), 5_000);
+    }
+
+    #[test]
+    fn the_basic_answers_over_a_115200_link_no_faster_than_the_wire() {
+        let mut robot = VirtualRobot::new(RobotConfig::default());
+        robot.run_for(10_000);
+        let request = Request::GetBasicVersion.to_frame();
+        let start = robot.now_us();
+        let reply = robot
+            .transact(&request)
+            .expect("the Basic answers its version");
+        assert_eq!(reply.cmd(), request.cmd());
+        assert!(matches!(
+            Reply::parse(Request::GetBasicVersion.reply_kind(), &reply),
+            Ok(Reply::Byte(_))
+        ));
+        let both_ways = wire_time_us(
+            (request.encoded_len() + reply.encoded_len()) as u32,
+            HOST_BAUD,
+        );
+        assert!(robot.now_us() - start >= both_ways);
+    }
+
+    #[test]
+    fn without_a_basic_the_basic_port_is_dead() {
+        let mut robot = VirtualRobot::new(RobotConfig {
+            with_basic: false,
+            ..RobotConfig::default()
+        });
+        assert!(robot.basic().is_none());
+        assert_eq!(robot.ask(&Request::GetBasicVersion), Err(AskError::NoReply));
+    }
+
+    #[test]
+    fn measured_angles_follow_the_shafts() {
+        let mut robot = VirtualRobot::new(RobotConfig::default());
+        robot
+            .servo_mut(3)
+            .expect("servo 3")
+            .move_by_hand(2048 + 1024);
+        let angles = robot.measured_angles();
+        assert_eq!(angles[2], Centideg(9_000));
+        assert_eq!(angles[0], Centideg(0));
+    }
+
+    #[test]
+    fn servos_are_found_by_their_present_id() {
+        let robot = VirtualRobot::new(RobotConfig::default());
+        assert_eq!(robot.servos().count(), 7);
+        assert_eq!(robot.servo(7).map(SimServo::id), Some(7));
+        assert!(robot.servo(8).is_none());
+        assert!(robot.servo_station(1).is_some());
+    }
+}

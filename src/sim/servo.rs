@@ -5,7 +5,8 @@
 //! id (or the broadcast id), and queues its status reply to start after its return delay
 //! (register 7, in 2 us units) plus [`PROCESSING_NS`]. Its shaft moves in fixed control steps of
 //! [`CONTROL_PERIOD_NS`] towards the goal position with the goal speed and acceleration, and the
-//! present-state registers (56..70) follow.
+//! present-state registers (56..70) follow. A goal speed of 0 means full speed; the goal time
+//! (register 44) is stored but not used, as the firmware always sends a speed.
 //!
 //! Positions: the shaft has a raw encoder position; registers report `raw - homing offset`
 //! (register 31), so writing 128 to torque enable (calibration) makes the present position 2048
