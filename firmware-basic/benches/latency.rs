@@ -155,13 +155,14 @@ fn main() {
     }
     let idle_ns = t.elapsed().as_nanos() as f64 / polls as f64;
     let t = Instant::now();
-    let mut done = 0;
-    while done < polls {
-        if rig.host.from_basic.len() % 17 == 0 {
+    // One get_angles after another, each sent when the previous 17-byte reply is complete.
+    let mut replied_bytes = rig.host.from_basic.len();
+    for _ in 0..polls {
+        if rig.host.from_basic.len() >= replied_bytes {
             rig.host.send(&frame(0x20, &[]));
+            replied_bytes += 17;
         }
         rig.step();
-        done += 1;
     }
     let busy_ns = t.elapsed().as_nanos() as f64 / polls as f64;
     println!(
