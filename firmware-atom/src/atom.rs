@@ -12,7 +12,7 @@
 
 use heapless::Deque;
 use protocol_core::servo::{Packet, reg, sign_magnitude};
-use protocol_core::timing::{ATOM_TRANSACTION_GAP_US, HOST_FRAME_GAP_US};
+use protocol_core::timing::{ATOM_TRANSACTION_GAP_US, BUS_BAUD, HOST_FRAME_GAP_US, wire_time_us};
 use protocol_core::units::{Centideg, Steps};
 use protocol_core::{BytePort, Frame, FrameDecoder};
 
@@ -39,6 +39,11 @@ const MOTION_QUEUE: usize = 16;
 /// A servo that stopped answering is probed only every this many refresh rounds, so a missing
 /// servo (often the gripper) does not cost its timeout in every round.
 const LOST_SERVO_PROBE_ROUNDS: u8 = 8;
+
+/// How long after its last byte a frame equal to our last bus reply is taken for its echo.
+/// 300 us: far beyond the echo's arrival (tens of us), far below the time a client needs to
+/// receive that reply through the Basic and send a new request (over a millisecond at 115200).
+const OWN_REPLY_WINDOW_US: u64 = 300;
 
 /// Which host link a request came from (its reply goes back there).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -131,6 +136,10 @@ pub struct Atom {
     usb_frames: FrameDecoder,
     usb_last_rx_us: u64,
     bus_reply: Option<Frame>,
+    /// The last reply sent on the bus and when its echo window closes: a frame equal to it
+    /// heard before then is our own echo that slipped past the echo filter (some replies,
+    /// e.g. angles to coords, have the layout of a valid request).
+    last_bus_reply: Option<(Frame, u64)>,
     // Bus schedule.
     driver: ServoDriver,
     jobs: Deque<Job, OP_QUEUE>,
@@ -162,6 +171,9 @@ pub struct Atom {
 }
 
 /// A motion stepped in Cartesian space every interpolation period.
+// One instance lives inside the Atom (no allocation to box into), so the size of the larger
+// variant costs nothing extra.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 enum Stepper {
     /// A straight line (send coords mode 1).
@@ -169,6 +181,7 @@ enum Stepper {
         path: LinearPath,
         next_us: u64,
         target: Pose,
+        speed_percent: u8,
     },
     /// A continuous Cartesian jog: axis 0..2 = x, y, z, 3..5 = rotation about base x, y, z.
     Jog {
@@ -202,6 +215,7 @@ impl Atom {
             usb_frames: FrameDecoder::new(),
             usb_last_rx_us: 0,
             bus_reply: None,
+            last_bus_reply: None,
             driver: ServoDriver::new(config.timing.reply_margin_us),
             jobs: Deque::new(),
             pending_goals: None,
@@ -287,6 +301,12 @@ impl Atom {
     ) {
         match event {
             BusEvent::Frame(frame) => {
+                if let Some((last, until_us)) = &self.last_bus_reply
+                    && now_us <= *until_us
+                    && *last == frame
+                {
+                    return;
+                }
                 if let Some(reply) = self.handle_frame(now_us, &frame, Link::Bus, io) {
                     // A newer request replaces an unsent reply: the host has given up on it.
                     self.bus_reply = Some(reply);
@@ -346,6 +366,8 @@ impl Atom {
             let bytes = reply.to_bytes();
             bus.write(&bytes);
             self.rx.on_transmit(now_us, &bytes);
+            let window_us = wire_time_us(bytes.len() as u32, BUS_BAUD) + OWN_REPLY_WINDOW_US;
+            self.last_bus_reply = Some((reply, now_us + window_us));
             return;
         }
         if self.rx.frame_in_progress()
@@ -922,6 +944,7 @@ impl Atom {
             path,
             next_us: now_us,
             target: pose,
+            speed_percent,
         });
         self.activity = Activity::Moving {
             target: angles,
@@ -974,6 +997,11 @@ impl Atom {
         let period = self.config.timing.interpolation_period_us;
         let Some(stepper) = self.stepper.as_mut() else {
             return;
+        };
+        let speed_percent = match stepper {
+            Stepper::Line { speed_percent, .. } | Stepper::Jog { speed_percent, .. } => {
+                *speed_percent
+            }
         };
         let next_angles = match stepper {
             Stepper::Line { path, next_us, .. } => {
@@ -1028,7 +1056,7 @@ impl Atom {
                     .map_err(|_| ActionError::Unreachable)
             }
         };
-        match next_angles.and_then(|q| self.step_to(&q, period)) {
+        match next_angles.and_then(|q| self.step_to(&q, period, speed_percent)) {
             Ok(q) => {
                 if let Some(Stepper::Jog { angles, .. }) = self.stepper.as_mut() {
                     *angles = q;
@@ -1041,11 +1069,13 @@ impl Atom {
         }
     }
 
-    /// Sends goals that reach joint angles `q` in one interpolation period.
+    /// Sends goals that reach joint angles `q` in one interpolation period, no joint faster
+    /// than the joint speed at `speed_percent` (a long step then takes longer than a period).
     fn step_to(
         &mut self,
         q: &[Centideg; JOINTS],
         period_us: u64,
+        speed_percent: u8,
     ) -> Result<[Centideg; JOINTS], ActionError> {
         self.check_target(&Target {
             angles: q.map(Some),
@@ -1053,18 +1083,27 @@ impl Atom {
         })?;
         let present = self.present_steps();
         let accel = motion::joint_accel_register(&self.config);
-        let max_speed = motion::joint_speed_steps(&self.config, 100);
+        let max_speed = u64::from(motion::joint_speed_steps(&self.config, speed_percent));
+        let goal_steps: [Steps; JOINTS] = core::array::from_fn(|j| {
+            self.config
+                .angle_to_steps(j, q.get(j).copied().unwrap_or_default())
+        });
+        let travel = |j: usize| -> u64 {
+            match (goal_steps.get(j), present.get(j)) {
+                (Some(g), Some(p)) => u64::from((i32::from(g.0) - i32::from(p.0)).unsigned_abs()),
+                _ => 0,
+            }
+        };
+        // The step takes one period, or longer if the farthest joint cannot make it in time;
+        // every joint's speed is scaled to that time so all arrive together.
+        let longest = (0..JOINTS).map(travel).max().unwrap_or(0);
+        let step_us = (longest * 1_000_000 / max_speed.max(1)).max(period_us.max(1));
         let mut goals: GoalSet = [None; SERVOS];
         for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
-            let goal = self
-                .config
-                .angle_to_steps(j, q.get(j).copied().unwrap_or_default());
-            let from = present.get(j).map_or(goal.0, |p| p.0);
-            let travel = u64::from((i32::from(goal.0) - i32::from(from)).unsigned_abs());
-            let speed = (travel * 1_000_000 / period_us.max(1)).clamp(1, u64::from(max_speed));
-            *slot = Some(Goal {
-                position: goal,
-                speed_steps_per_s: speed as u16,
+            let speed = (travel(j) * 1_000_000 / step_us).clamp(1, max_speed.max(1));
+            *slot = goal_steps.get(j).map(|&position| Goal {
+                position,
+                speed_steps_per_s: speed.min(u64::from(u16::MAX)) as u16,
                 accel,
             });
         }

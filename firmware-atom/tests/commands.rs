@@ -387,3 +387,23 @@ fn state_refresh_runs_at_100_hz_or_faster() {
     let rounds = rig.atom.refresh_rounds() - before;
     assert!(rounds >= 10, "{rounds} rounds in 100 ms");
 }
+
+#[test]
+fn own_reply_heard_late_is_not_taken_for_a_request() {
+    // A bus without echo, where the reply comes back later than the echo window (a slow
+    // transceiver): angles-to-coords replies have the layout of a valid request.
+    let mut rig = Rig::with(
+        firmware_atom::AtomConfig {
+            powered_at_boot: true,
+            ..Default::default()
+        },
+        false,
+    );
+    let request = Frame::new(0x23, &be(&[0, 0, 0, 0, 0, 0])).unwrap();
+    let reply = rig.request(&request).unwrap();
+    rig.run_us(50);
+    let replies = rig.bus.replies.len();
+    rig.bus.send_raw(&reply.to_bytes());
+    rig.run_ms(5);
+    assert_eq!(rig.bus.replies.len(), replies, "no reply to our own reply");
+}

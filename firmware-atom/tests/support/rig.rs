@@ -109,7 +109,7 @@ impl Rig {
             .iter()
             .rev()
             .take(256)
-            .any(|&(t, who, _)| who == 'A' && t > start && t <= end + super::BYTE_US)
+            .any(|&(t, who, _)| who == 'A' && t > start && t <= end)
     }
 
     pub fn request(&mut self, frame: &Frame) -> Option<Frame> {
