@@ -11,14 +11,13 @@ use esp_hal::{
 };
 use firmware_atom::io::{AtomIo, OUTPUT_PINS, PinMode};
 
-use crate::leds::Leds;
+use crate::{
+    leds::Leds,
+    pwm::{duty_bits, duty_ticks},
+};
 
-/// Widest PWM duty resolution used, in bits (the widest every LEDC version supports).
-const MAX_DUTY_BITS: u32 = 14;
 /// Protocol number of the button pin, readable like a user input (`firmware_atom::io`).
 const BUTTON_PIN: u8 = 39;
-/// LEDC low-speed timer clock (APB), in Hz.
-const LEDC_CLOCK_HZ: u32 = 80_000_000;
 
 /// One user pin: its GPIO and the LEDC timer, channel and signal reserved for its PWM.
 pub struct UserPin<'d> {
@@ -76,14 +75,6 @@ fn make_input(gpio: &mut Flex<'_>, pull: Pull) {
     gpio.set_output_enable(false);
     gpio.apply_input_config(&InputConfig::default().with_pull(pull));
     gpio.set_input_enable(true);
-}
-
-/// The duty resolution for a PWM frequency: as fine as the 80 MHz clock allows, at most
-/// [`MAX_DUTY_BITS`]. `None` for 0 Hz or frequencies too high for even 1 bit.
-fn duty_bits(freq_hz: u16) -> Option<u32> {
-    let ticks_per_period = LEDC_CLOCK_HZ.checked_div(u32::from(freq_hz))?;
-    let bits = ticks_per_period.checked_ilog2()?.min(MAX_DUTY_BITS);
-    (bits >= 1).then_some(bits)
 }
 
 impl AtomIo for BoardIo<'_> {
@@ -150,7 +141,7 @@ impl AtomIo for BoardIo<'_> {
         if pwm.configure(channel_config).is_err() {
             return false;
         }
-        pwm.set_duty_hw((u32::from(duty_0_255) << bits) / 255);
+        pwm.set_duty_hw(duty_ticks(duty_0_255, bits));
         user.signal.connect_to(&user.gpio);
         user.gpio.set_output_enable(true);
         *pwm_on = true;

@@ -1,5 +1,6 @@
 //! The Atom's WS2812 RGB LEDs, driven by one RMT channel: every data bit is one RMT pulse code.
 
+use crate::ws2812::{BITS_PER_LED, led_bits};
 use esp_hal::{
     Blocking,
     gpio::{Level, interconnect::PeripheralOutput},
@@ -11,7 +12,6 @@ pub const LED_COUNT: usize = 25;
 /// RMT tick rate the pulse lengths below are counted in (APB clock, divider 1).
 pub const RMT_TICK_MHZ: u32 = 80;
 
-const BITS_PER_LED: usize = 24;
 /// One pulse code per data bit, plus the end marker.
 const PULSE_COUNT: usize = LED_COUNT * BITS_PER_LED + 1;
 
@@ -47,12 +47,9 @@ impl<'d> Leds<'d> {
 
     /// Shows one colour on every LED. Blocks for the chain's wire time (0.75 ms for 25 LEDs).
     pub fn fill(&mut self, red: u8, green: u8, blue: u8) {
-        // WS2812 order: green, red, blue, most significant bit first.
-        let grb = (u32::from(green) << 16) | (u32::from(red) << 8) | u32::from(blue);
         let (data, _end_marker) = self.pulses.split_at_mut(PULSE_COUNT - 1);
-        for (index, pulse) in data.iter_mut().enumerate() {
-            let bit = BITS_PER_LED - 1 - index % BITS_PER_LED;
-            *pulse = if grb & (1 << bit) != 0 { ONE } else { ZERO };
+        for (pulse, bit) in data.iter_mut().zip(led_bits(red, green, blue).cycle()) {
+            *pulse = if bit { ONE } else { ZERO };
         }
         // A failed transmission leaves the LEDs as they were; the next fill tries again.
         if let Ok(transaction) = self.channel.reborrow().transmit(&self.pulses) {

@@ -12,7 +12,9 @@
 mod board_io;
 mod leds;
 mod pins;
+mod pwm;
 mod uart_port;
+mod ws2812;
 
 use esp_hal::{
     clock::CpuClock,

@@ -13,6 +13,7 @@
 mod board_io;
 mod pins;
 mod screen;
+mod screen_text;
 mod uart_port;
 
 use embedded_graphics::{pixelcolor::Rgb565, prelude::*};

@@ -1,0 +1,5 @@
+//! Host tests of the Basic board binary's hardware-free parts; the binary itself builds only
+//! for a chip (docs/boards.md).
+
+#[path = "screen_text.rs"]
+mod screen_text;
