@@ -151,14 +151,52 @@ impl FrameDecoder {
     }
 
     /// Feeds every byte of `bytes`, calling `on_frame` with each frame found, in order.
-    pub fn feed(&mut self, bytes: &[u8], mut on_frame: impl FnMut(Frame)) {
-        for &b in bytes {
-            if let Some(frame) = self.push(b) {
-                on_frame(frame);
-                while let Some(frame) = self.next_frame() {
-                    on_frame(frame);
+    ///
+    /// Same result as [`push`](Self::push)ing byte by byte and draining, but faster: while idle
+    /// it skips straight to the next `FE`, and once a candidate's LEN is known it copies the
+    /// rest of the candidate in one go.
+    pub fn feed(&mut self, mut bytes: &[u8], mut on_frame: impl FnMut(Frame)) {
+        while !bytes.is_empty() {
+            let take = if self.stale != 0 {
+                1
+            } else if self.buf.is_empty() {
+                // Idle: no byte before the next FE can start a frame.
+                let skip = bytes
+                    .iter()
+                    .position(|&b| b == HEADER)
+                    .unwrap_or(bytes.len());
+                // skip <= bytes.len(); a wrap of the statistics counter is harmless.
+                self.skipped = self.skipped.wrapping_add(skip as u32);
+                bytes = bytes.get(skip..).unwrap_or_default();
+                if bytes.is_empty() {
+                    return;
                 }
+                1
+            } else {
+                self.missing().clamp(1, bytes.len())
+            };
+            let (chunk, rest) = bytes.split_at(take.min(bytes.len()));
+            bytes = rest;
+            for &b in chunk {
+                if self.buf.is_full() {
+                    self.drop_front(1);
+                }
+                let _ = self.buf.push(b);
             }
+            while let Some(frame) = self.next_frame() {
+                on_frame(frame);
+            }
+        }
+    }
+
+    /// Bytes still missing from the candidate at the front of the buffer, once its LEN is
+    /// known; 1 while the header is incomplete.
+    fn missing(&self) -> usize {
+        match self.buf.as_slice() {
+            [HEADER, HEADER, len, ..] if (MIN_LEN..=MAX_LEN).contains(len) => {
+                (3 + *len as usize).saturating_sub(self.buf.len())
+            }
+            _ => 1,
         }
     }
 

@@ -510,14 +510,52 @@ impl PacketDecoder {
     }
 
     /// Feeds every byte of `bytes`, calling `on_packet` with each packet found, in order.
-    pub fn feed(&mut self, bytes: &[u8], mut on_packet: impl FnMut(Packet)) {
-        for &b in bytes {
-            if let Some(p) = self.push(b) {
-                on_packet(p);
-                while let Some(p) = self.next_packet() {
-                    on_packet(p);
+    ///
+    /// Same result as [`push`](Self::push)ing byte by byte and draining, but faster: while idle
+    /// it skips straight to the next `FF`, and once a candidate's LEN is known it copies the
+    /// rest of the candidate in one go.
+    pub fn feed(&mut self, mut bytes: &[u8], mut on_packet: impl FnMut(Packet)) {
+        while !bytes.is_empty() {
+            let take = if self.stale != 0 {
+                1
+            } else if self.buf.is_empty() {
+                // Idle: no byte before the next FF can start a packet.
+                let skip = bytes
+                    .iter()
+                    .position(|&b| b == HEADER)
+                    .unwrap_or(bytes.len());
+                bytes = bytes.get(skip..).unwrap_or_default();
+                if bytes.is_empty() {
+                    return;
                 }
+                1
+            } else {
+                self.missing().clamp(1, bytes.len())
+            };
+            let (chunk, rest) = bytes.split_at(take.min(bytes.len()));
+            bytes = rest;
+            for &b in chunk {
+                if self.buf.is_full() {
+                    self.drop_front(1);
+                }
+                let _ = self.buf.push(b);
             }
+            while let Some(packet) = self.next_packet() {
+                on_packet(packet);
+            }
+        }
+    }
+
+    /// Bytes still missing from the candidate at the front of the buffer, once its LEN is
+    /// known; 1 while the header is incomplete.
+    fn missing(&self) -> usize {
+        match self.buf.as_slice() {
+            [HEADER, HEADER, id, len, ..]
+                if *id != HEADER && (2..=MAX_PARAMS as u8 + 2).contains(len) =>
+            {
+                (4 + *len as usize).saturating_sub(self.buf.len())
+            }
+            _ => 1,
         }
     }
 

@@ -503,6 +503,46 @@ proptest! {
     }
 
     #[test]
+    fn feed_fast_path_matches_byte_by_byte_push(
+        parts in prop::collection::vec(prop_oneof![
+            noise(0xFE),
+            noise(0xFF),
+            prop::collection::vec(prop_oneof![Just(0xFEu8), Just(0xFF), Just(0x05), any::<u8>()], 0..80),
+            any_frame().prop_map(|f| f.to_bytes().to_vec()),
+            any_packet().prop_map(|p| p.to_bytes().to_vec()),
+        ], 0..12),
+        cuts in prop::collection::vec(any::<usize>(), 0..8),
+        quiet in prop::collection::vec(any::<bool>(), 8),
+    ) {
+        let stream: Vec<u8> = parts.concat();
+        let (mut fast, mut slow) = (FrameDecoder::new(), FrameDecoder::new());
+        let (mut pfast, mut pslow) = (PacketDecoder::new(), PacketDecoder::new());
+        let (mut out_fast, mut out_slow) = (Vec::new(), Vec::new());
+        let (mut pout_fast, mut pout_slow) = (Vec::new(), Vec::new());
+        for (i, chunk) in chunks(&stream, &cuts).into_iter().enumerate() {
+            if quiet[i % quiet.len()] {
+                out_fast.extend(fast.on_quiet_line());
+                out_slow.extend(slow.on_quiet_line());
+                pout_fast.extend(pfast.on_quiet_line());
+                pout_slow.extend(pslow.on_quiet_line());
+            }
+            fast.feed(chunk, |f| out_fast.push(f));
+            pfast.feed(chunk, |p| pout_fast.push(p));
+            for &b in chunk {
+                out_slow.extend(slow.push(b));
+                while let Some(f) = slow.next_frame() { out_slow.push(f); }
+                pout_slow.extend(pslow.push(b));
+                while let Some(p) = pslow.next_packet() { pout_slow.push(p); }
+            }
+        }
+        prop_assert_eq!(out_fast, out_slow);
+        prop_assert_eq!(fast.skipped_bytes(), slow.skipped_bytes());
+        prop_assert_eq!(fast.has_partial(), slow.has_partial());
+        prop_assert_eq!(pout_fast, pout_slow);
+        prop_assert_eq!(pfast.checksum_errors(), pslow.checksum_errors());
+    }
+
+    #[test]
     fn every_request_round_trips(req in request()) {
         let frame = req.to_frame();
         prop_assert_eq!(frame.cmd(), req.cmd());
