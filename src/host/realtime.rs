@@ -1,10 +1,12 @@
 //! Runs the virtual robot in real time and connects it to the host's clients.
 //!
-//! One loop, no threads: wait up to [`TICK`] for a client's bytes (`ppoll`, so input wakes it
-//! at once), advance the robot's virtual time to the wall clock, hand it the input, and pass
-//! what the Basic sent back to the client that spoke last. With a 200 us tick, a reply leaves
-//! at most ~200 us after the simulated wire finished sending it, well under the 87 us x 17
-//! bytes a `get_angles` reply spends on the 115200 baud wire itself.
+//! One loop, no threads: wait for a client's bytes (`ppoll`, so input wakes it at once) or the
+//! next tick, advance the robot's virtual time to the wall clock, hand it the input, and pass
+//! what the robot sent back to the client that spoke last. While clients are talking the tick
+//! is [`ACTIVE_TICK`], so a reply leaves at most that long after the simulated 115200 baud
+//! wire finished sending it (the wire itself takes 87 us per byte, 1.5 ms for a `get_angles`
+//! reply); when the line has been quiet for [`ACTIVE_SPELL`] the loop ticks at [`IDLE_TICK`]
+//! and costs almost no CPU.
 
 use std::io;
 use std::os::fd::BorrowedFd;
@@ -20,8 +22,15 @@ use crate::sim::{HostLink, VirtualRobot};
 use super::pty::PseudoTerminal;
 use super::tcp::{ClientId, TcpServer};
 
-/// The longest the loop sleeps between two advances of virtual time.
-pub const TICK: Duration = Duration::from_micros(200);
+/// The longest the loop sleeps between two advances of virtual time while clients talk.
+pub const ACTIVE_TICK: Duration = Duration::from_micros(50);
+
+/// The longest the loop sleeps when the line is quiet (input still wakes it at once).
+pub const IDLE_TICK: Duration = Duration::from_millis(1);
+
+/// How long after the last byte in either direction the loop keeps the short tick: longer
+/// than any reply takes to start (the firmware answers within a few milliseconds).
+pub const ACTIVE_SPELL: Duration = Duration::from_millis(50);
 
 /// If the simulation falls this far behind the wall clock (a slow or overloaded machine, a
 /// stopped process), the debt is forgiven instead of fast-forwarding the arm in one jump.
@@ -103,10 +112,12 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
         // Virtual time = virtual_at_sync + wall time since wall_sync.
         let mut wall_sync = Instant::now();
         let mut virtual_at_sync = self.robot.now_us();
+        let mut last_traffic: Option<Instant> = None;
         let mut input = [0u8; 4096];
         let mut output = Vec::with_capacity(256);
         while !stop.load(Ordering::Relaxed) {
-            self.wait_for_input()?;
+            let active = last_traffic.is_some_and(|t| t.elapsed() < ACTIVE_SPELL);
+            self.wait_for_input(if active { ACTIVE_TICK } else { IDLE_TICK })?;
 
             let mut target_us = virtual_at_sync.saturating_add(micros(wall_sync.elapsed()));
             if target_us > self.robot.now_us() + micros(MAX_CATCH_UP) {
@@ -116,31 +127,36 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             }
             self.robot.run_until(target_us);
 
-            self.forward_client_input(&mut input)?;
+            let had_input = self.forward_client_input(&mut input)?;
 
             output.clear();
             self.robot.host_read(&mut output);
             if !output.is_empty() {
                 self.deliver(&output)?;
             }
+            if had_input || !output.is_empty() {
+                last_traffic = Some(Instant::now());
+            }
         }
         Ok(self.robot)
     }
 
-    /// Sleeps until a client sends something or [`TICK`] passes.
-    fn wait_for_input(&self) -> io::Result<()> {
+    /// Sleeps until a client sends something or `tick` passes.
+    fn wait_for_input(&self, tick: Duration) -> io::Result<()> {
         let pty_fd: BorrowedFd<'_> = std::os::fd::AsFd::as_fd(&self.pty);
         let mut fds: Vec<PollFd<'_>> = std::iter::once(pty_fd)
             .chain(self.tcp.iter().flat_map(TcpServer::poll_fds))
             .map(|fd| PollFd::new(fd, PollFlags::POLLIN))
             .collect();
-        match ppoll(&mut fds, Some(TimeSpec::from_duration(TICK)), None) {
+        match ppoll(&mut fds, Some(TimeSpec::from_duration(tick)), None) {
             Ok(_) | Err(nix::errno::Errno::EINTR) => Ok(()),
             Err(e) => Err(e.into()),
         }
     }
 
-    fn forward_client_input(&mut self, buf: &mut [u8]) -> io::Result<()> {
+    /// Hands everything clients sent to the robot; tells whether there was anything.
+    fn forward_client_input(&mut self, buf: &mut [u8]) -> io::Result<bool> {
+        let mut any = false;
         loop {
             let n = self.pty.read_available(buf)?;
             let Some(bytes) = buf.get(..n).filter(|b| !b.is_empty()) else {
@@ -148,6 +164,7 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             };
             self.robot.host_write(bytes);
             self.talker = Talker::Pty;
+            any = true;
         }
         if let Some(tcp) = self.tcp.as_mut() {
             tcp.accept_pending();
@@ -156,9 +173,10 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             tcp.receive(|id, bytes| {
                 robot.host_write(bytes);
                 *talker = Talker::Tcp(id);
+                any = true;
             });
         }
-        Ok(())
+        Ok(any)
     }
 
     fn deliver(&mut self, bytes: &[u8]) -> io::Result<()> {
