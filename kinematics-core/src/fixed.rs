@@ -141,11 +141,11 @@ pub fn atan2(y: i64, x: i64) -> Angle {
     let excess = (u64::BITS - big.leading_zeros()).saturating_sub(ATAN_INPUT_BITS);
     let (big, small) = ((big >> excess) as i64, (small >> excess) as i64);
     // t = small / big in [0, 1], Q30.
-    let t = (small << 30) / big.max(1);
+    let t = ratio(small << 30, big);
     // Nearest sixteenth c = k/16, then atan(t) = atan(c) + atan((t - c) / (1 + t c)), |u| <= 1/32.
     let k = ((t + (1 << 25)) >> 26).clamp(0, 16);
     let c = k << 26;
-    let u = ((t - c) << 30) / (ONE + mul(t, c));
+    let u = ratio((t - c) << 30, ONE + mul(t, c));
     let u2 = mul(u, u);
     // atan(u) = u (1 - u^2/3 + u^4/5 - u^6/7): error < 1e-14 for |u| <= 1/32.
     let poly = mul(u, ONE - mul(u2, ONE / 3 - mul(u2, ONE / 5 - u2 / 7)));
@@ -161,6 +161,13 @@ pub fn atan2(y: i64, x: i64) -> Angle {
         a = -a;
     }
     Angle(a as i32)
+}
+
+/// num / den, 0 for a zero denominator (never reached: callers divide by positive values; this
+/// keeps division panics out of the binary).
+#[inline]
+pub fn ratio(num: i64, den: i64) -> i64 {
+    num.checked_div(den).unwrap_or(0)
 }
 
 /// Square root of a non-negative value, rounded down; 0 for negative input.

@@ -99,6 +99,8 @@ pub(crate) fn solve(
         let c5 = mul(z[0], s1) - mul(z[1], c1);
         let (x1, y1) = (mul(z[0], c1) + mul(z[1], s1), z[2]);
         let s5 = sqrt(x1 * x1 + y1 * y1);
+        // The flange in frame 1: M = A1^-1 * T06.
+        let m = links.link(0, t1).inverse().then(target);
         for (wrist, sign5) in [1i64, -1].into_iter().enumerate() {
             let t5 = atan2(sign5 * s5, c5);
             let t6 = if s5 < WRIST_SINGULAR_SIN {
@@ -108,11 +110,16 @@ pub(crate) fn solve(
                 let cos6 = mul(s1, r.at(0, 0)) - mul(c1, r.at(1, 0));
                 atan2(sign5 * sin6, sign5 * cos6)
             };
-            let a1 = links.link(0, t1);
+            // T14 = M * A56^-1; only its rotation's first column and position are needed:
+            // R14 e_x = M.R * (row 0 of R56), p14 = M.p - M.R * R56^T * p56.
             let a56 = links.link(4, t5).then(&links.link(5, t6));
-            let t14 = a1.inverse().then(target).then(&a56.inverse());
-            let t234 = atan2(t14.rotation.at(1, 0), t14.rotation.at(0, 0));
-            let [ex, ey, _] = t14.position;
+            let r56 = &a56.rotation;
+            let [x14_x, x14_y, _] = m
+                .rotation
+                .apply(&[r56.at(0, 0), r56.at(0, 1), r56.at(0, 2)]);
+            let [bx, by, _] = m.rotation.apply(&r56.transpose().apply(&a56.position));
+            let t234 = atan2(x14_y, x14_x);
+            let (ex, ey) = (m.position[0] - bx, m.position[1] - by);
             let l2 = ex * ex + ey * ey;
             if !within(l2, d_len - REACH_TOLERANCE, s_len + REACH_TOLERANCE) {
                 continue;

@@ -223,7 +223,7 @@ impl Kinematics {
             let offset = self.links.offset.get(i).copied().unwrap_or(Angle::ZERO);
             *slot = self.limits.wrap_into(i, t.sub(offset).to_centideg(), s)?;
             let d = i64::from(*slot) - i64::from(s);
-            distance += d * d;
+            distance = distance.saturating_add(d.saturating_mul(d));
         }
         Some((JointAngles(q), distance))
     }

@@ -3,7 +3,7 @@
 //! with the previous step as seed, so the arm stays on one branch. A step that has no solution,
 //! or whose solution would make a joint jump, stops the path instead of being executed.
 
-use crate::fixed::Angle;
+use crate::fixed::{Angle, ratio};
 use crate::transform::{LEN_PER_TENTH_MM, Rotation, Transform};
 use crate::{IkError, JointAngles, Kinematics, Pose};
 
@@ -115,9 +115,9 @@ impl LinearPath {
         let lerp = |i: usize| {
             let a = self.start.position.get(i).copied().unwrap_or(0);
             let b = self.target.position.get(i).copied().unwrap_or(0);
-            a + (b - a) * num / den
+            a + ratio((b - a) * num, den)
         };
-        let turn = Angle((i64::from(self.angle.0) * num / den) as i32);
+        let turn = Angle(ratio(i64::from(self.angle.0) * num, den) as i32);
         Transform {
             rotation: self
                 .start
@@ -177,7 +177,7 @@ impl LinearPath {
 
 /// a / b rounded up, for a >= 0 and b > 0.
 fn div_ceil(a: i64, b: i64) -> i64 {
-    (a + b - 1) / b
+    ratio(a + b - 1, b)
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! conversion to and from the wire's [`Pose`] (0.1 mm, 0.01 deg, R = Rz(rz) * Ry(ry) * Rx(rx)).
 
 use crate::Pose;
-use crate::fixed::{Angle, ONE, atan2, mul, sqrt};
+use crate::fixed::{Angle, ONE, atan2, mul, ratio, sqrt};
 
 /// Internal length unit: 1/16 micrometre, i.e. this many units per 0.1 mm. Fine enough that
 /// rounding never shows at the wire's 0.1 mm; coarse enough that a Q30 rotation times a
@@ -128,7 +128,7 @@ impl Rotation {
             return ([ONE, 0, 0], Angle::ZERO);
         }
         let half = atan2(norm, w);
-        ([x, y, z].map(|v| (v << 30) / norm), half.add(half))
+        ([x, y, z].map(|v| ratio(v << 30, norm)), half.add(half))
     }
 
     /// The product self * other.

@@ -1,0 +1,65 @@
+//! Host timing of forward kinematics, full inverse kinematics (all branches + selection) and a
+//! linear-path step: `cargo bench -p kinematics-core`. Instruction counts per call:
+//! `kinematics-core/benches/callgrind.sh`.
+#![allow(missing_docs)]
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use kinematics_core::{JointAngles, Kinematics, LinearPath, Pose};
+use std::hint::black_box;
+
+/// A spread of in-limit configurations (none singular).
+const CONFIGS: [[i32; 6]; 4] = [
+    [1_000, -3_000, -6_000, 1_500, 2_000, 500],
+    [-4_500, 2_000, 7_000, -3_000, -6_000, 9_000],
+    [12_000, -8_000, 4_000, 6_000, 3_000, -12_000],
+    [-15_000, 6_000, -11_000, -9_000, 12_000, 3_000],
+];
+
+fn bench(c: &mut Criterion) {
+    let kin = Kinematics::new();
+    let configs = CONFIGS.map(JointAngles);
+    let poses = configs.map(|q| kin.forward(&q));
+
+    c.bench_function("forward (4 poses)", |b| {
+        b.iter(|| {
+            configs
+                .iter()
+                .map(|q| kin.forward(black_box(q)))
+                .fold(0, |a, p| a ^ p.x)
+        })
+    });
+    c.bench_function("inverse (4 poses, all branches + nearest)", |b| {
+        b.iter(|| {
+            poses
+                .iter()
+                .zip(configs.iter())
+                .map(|(p, q)| {
+                    kin.inverse(black_box(p), black_box(q))
+                        .map_or(0, |s| s.0[0])
+                })
+                .fold(0, |a, v| a ^ v)
+        })
+    });
+    let start = configs[0];
+    let from = poses[0];
+    let to = Pose {
+        x: from.x - 400,
+        y: from.y + 300,
+        z: from.z - 200,
+        ..from
+    };
+    c.bench_function("linear path, 27 steps of 2 mm", |b| {
+        b.iter(|| {
+            let mut path =
+                LinearPath::new(&kin, black_box(&start), black_box(&to), 20).map_or(None, Some);
+            let mut n = 0;
+            while let Some(Some(Ok(_))) = path.as_mut().map(|p| p.next(&kin)) {
+                n += 1;
+            }
+            n
+        })
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
