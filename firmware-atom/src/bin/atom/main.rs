@@ -160,6 +160,5 @@ fn user_pin(pin: AnyPin<'static>, ledc: &Ledc<'static>, index: u8) -> UserPin<'s
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     board_log!("panic: {}", info);
-    let _ = info;
     esp_hal::system::software_reset()
 }

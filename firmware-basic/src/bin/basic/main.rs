@@ -75,19 +75,8 @@ fn main() -> ! {
     let _ = pins.speaker.set_low();
     board_log!("open-mycobot basic {}", env!("CARGO_PKG_VERSION"));
 
-    let host_uart = Uart::new(p.UART0, uart_port::config(HOST_BAUD))
-        .unwrap_or_else(|_| panic!("host UART configuration refused"))
-        .with_tx(pins.host_tx)
-        .with_rx(pins.host_rx);
-    let mut host = UartPort::new(host_uart, HOST_BAUD);
-    let bus_uart = Uart::new(p.UART1, uart_port::config(BUS_BAUD))
-        .unwrap_or_else(|_| panic!("bus UART configuration refused"))
-        .with_tx(pins.bus_tx)
-        .with_rx(pins.bus_rx);
-    let mut bus = UartPort::new(bus_uart, BUS_BAUD);
-    let mut io = BoardIo::new(pins.outputs, pins.inputs, pins.buttons);
-
     // The LCD is a nicety: without it (driver refused, panel absent) the transponder runs on.
+    // It is set up first: its ~0.2 s of init delays would overflow the UARTs' receive FIFOs.
     let mut lcd_buffer = [0_u8; LCD_BUFFER_BYTES];
     let spi_config = SpiConfig::default()
         .with_frequency(Rate::from_mhz(LCD_SPI_MHZ))
@@ -115,6 +104,18 @@ fn main() -> ! {
     if screen.is_none() {
         board_log!("LCD did not initialise; running without a status screen");
     }
+
+    let host_uart = Uart::new(p.UART0, uart_port::config(HOST_BAUD))
+        .unwrap_or_else(|_| panic!("host UART configuration refused"))
+        .with_tx(pins.host_tx)
+        .with_rx(pins.host_rx);
+    let mut host = UartPort::new(host_uart, HOST_BAUD);
+    let bus_uart = Uart::new(p.UART1, uart_port::config(BUS_BAUD))
+        .unwrap_or_else(|_| panic!("bus UART configuration refused"))
+        .with_tx(pins.bus_tx)
+        .with_rx(pins.bus_rx);
+    let mut bus = UartPort::new(bus_uart, BUS_BAUD);
+    let mut io = BoardIo::new(pins.outputs, pins.inputs, pins.buttons);
 
     let mut basic = Basic::new(BasicConfig::default());
 
@@ -145,6 +146,5 @@ fn main() -> ! {
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     board_log!("panic: {}", info);
-    let _ = info;
     esp_hal::system::software_reset()
 }
