@@ -19,9 +19,9 @@ use crate::config::{BasicConfig, EchoMode};
 /// and waits for its reply; 8 absorbs clients that pipeline a few without letting a flood
 /// queue seconds of stale commands.
 pub const REQUEST_QUEUE_DEPTH: usize = 8;
-/// How long after the transmitter went idle the rest of an echo may still arrive (receiver
-/// latency of the board), in microseconds: two byte times at 1 Mbaud, shorter than any Atom
-/// turnaround so the reply is not mistaken for a broken echo.
+/// How long after the transmitter went idle the rest of an echo that has started (or one the
+/// wiring is known to give) may still arrive, in microseconds: two byte times at 1 Mbaud, the
+/// receiver's latency.
 pub const ECHO_GRACE_US: u64 = 20;
 /// Longest back-off after a collision, in microseconds.
 pub const MAX_BACKOFF_US: u64 = 2_000;
@@ -259,12 +259,12 @@ impl Forwarder {
         let collided = *collided;
         let silent = *echoed == 0;
         let grace_over = now_us.saturating_sub(done_at) >= ECHO_GRACE_US;
-        // Until the echo is known either way, give a late echo its grace time: taken for the
-        // Atom's reply, our own request would be passed to the host as its answer.
-        let silence_is_final = config.echo == EchoMode::Absent || self.echo_heard.is_some();
         if collided || (grace_over && (echo_required || !silent)) {
             self.on_collision(now_us, config, on_event);
-        } else if silent && !echo_required && (silence_is_final || grace_over) {
+        } else if silent && !echo_required {
+            // An echo starts while the frame is still going out (byte 1 comes back while
+            // byte 2 is sent): nothing back by now means this wiring does not echo, and what
+            // arrives from now on is the Atom's.
             if config.echo == EchoMode::Auto {
                 self.echo_heard = Some(false);
             }

@@ -303,3 +303,18 @@ fn button_a_powers_the_atom_on_again() {
     assert_eq!(got, [0x10]);
     assert!(rig.host.received().is_empty());
 }
+
+#[test]
+fn an_atom_answering_right_after_the_request_is_not_mistaken_for_a_broken_echo() {
+    for echo in [true, false] {
+        let mut rig = Rig::quiet(echo);
+        rig.atom_delay_ns = 0;
+        for _ in 0..3 {
+            rig.host.send(&frame(GET_ANGLES, &[]));
+            rig.run_us(5_000);
+        }
+        assert_eq!(rig.atom_got.len(), 3, "echo {echo}: each request sent once");
+        assert_eq!(rig.host_frames().len(), 3, "echo {echo}");
+        assert_eq!(rig.basic.status().collisions, 0, "echo {echo}");
+    }
+}

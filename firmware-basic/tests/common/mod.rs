@@ -122,21 +122,27 @@ impl Wire {
         self.txs.drain(..keep_from);
     }
 
-    /// The first time from `from_ns` at which `n` bytes fit on the wire without touching
-    /// traffic already scheduled, with the quiet time a polite station leaves around it.
+    /// The first time from `from_ns` at which the Atom can put `n` bytes on the wire without
+    /// touching traffic already scheduled: it leaves the quiet time around other stations'
+    /// traffic, and may answer the Basic right after its request.
     pub fn free_slot(&self, from_ns: u64, n: usize) -> u64 {
-        let quiet_ns = timing::BUS_QUIET_BEFORE_SEND_US * 1_000;
         let mut start = from_ns;
         loop {
             let end = start + n as u64 * BUS_BYTE_NS;
             let clash = self
                 .txs
                 .iter()
-                .filter(|t| t.start_ns < end + quiet_ns && start < t.end_ns() + quiet_ns)
+                .filter(|t| {
+                    let quiet_ns = match t.station {
+                        Station::Basic => 0,
+                        Station::Other => timing::BUS_QUIET_BEFORE_SEND_US * 1_000,
+                    };
+                    t.start_ns < end + quiet_ns && start < t.end_ns() + quiet_ns
+                })
                 .map(Tx::end_ns)
                 .max();
             match clash {
-                Some(busy_until) => start = busy_until + quiet_ns,
+                Some(busy_until) => start = busy_until + timing::BUS_QUIET_BEFORE_SEND_US * 1_000,
                 None => return start,
             }
         }
