@@ -40,6 +40,17 @@ const MOTION_QUEUE: usize = 16;
 /// servo (often the gripper) does not cost its timeout in every round.
 const LOST_SERVO_PROBE_ROUNDS: u8 = 8;
 
+/// Acceleration register of the fastest joint during stepped (linear, jog) motion: 254 x 100
+/// steps/s^2, the servo reaches full joint speed in under 70 ms.
+const STEP_ACCEL_REGISTER: u8 = 254;
+
+/// How long a fresh goal counts as "moving" before the servo's own moving flag is read back:
+/// several refresh rounds (a round takes about 3 ms).
+const GOAL_CONFIRM_US: u64 = 30_000;
+
+/// Distance from its goal within which a servo counts as arrived: 10 steps, under one degree.
+const IN_POSITION_STEPS: i32 = 10;
+
 /// How long after its last byte a frame equal to our last bus reply is taken for its echo.
 /// 300 us: far beyond the echo's arrival (tens of us), far below the time a client needs to
 /// receive that reply through the Basic and send a new request (over a millisecond at 115200).
@@ -157,6 +168,10 @@ pub struct Atom {
     pub(crate) speed_percent: u8,
     pub(crate) health: [ServoHealth; SERVOS],
     pub(crate) last_goal: [Option<Steps>; SERVOS],
+    /// When each servo last got a goal (it may not report moving until its next state read).
+    last_goal_us: [u64; SERVOS],
+    /// The time of the current poll.
+    now_us: u64,
     pub(crate) activity: Activity,
     pub(crate) paused: Option<Target>,
     queue: Deque<Target, MOTION_QUEUE>,
@@ -231,6 +246,8 @@ impl Atom {
             speed_percent: 100,
             health,
             last_goal: [None; SERVOS],
+            last_goal_us: [0; SERVOS],
+            now_us: 0,
             activity: Activity::Idle,
             paused: None,
             queue: Deque::new(),
@@ -255,6 +272,7 @@ impl Atom {
         usb: &mut U,
         io: &mut I,
     ) {
+        self.now_us = now_us;
         self.receive_bus(now_us, bus, usb, io);
         self.receive_usb(now_us, usb, io);
         if let Some((op, outcome)) = self.driver.poll(now_us, bus) {
@@ -520,6 +538,9 @@ impl Atom {
                 *slot = Some(*g);
                 if let Some(last) = self.last_goal.get_mut(i) {
                     *last = Some(g.position);
+                }
+                if let Some(t) = self.last_goal_us.get_mut(i) {
+                    *t = self.now_us;
                 }
                 let torque_off = self.health.get(i).is_some_and(|h| !h.torque_on);
                 if torque_off {
@@ -793,6 +814,25 @@ impl Atom {
                 .iter()
                 .take(JOINTS)
                 .any(|h| h.answering && h.moving)
+    }
+
+    /// True while servo `index` moves: its moving flag, or a goal sent moments ago that its
+    /// state read has not confirmed yet (so "is moving" right after a command says yes).
+    pub(crate) fn servo_moving(&self, index: usize) -> bool {
+        let Some(h) = self.health.get(index) else {
+            return false;
+        };
+        let recent = self
+            .last_goal_us
+            .get(index)
+            .is_some_and(|&t| self.now_us.saturating_sub(t) < GOAL_CONFIRM_US);
+        let far = self
+            .last_goal
+            .get(index)
+            .copied()
+            .flatten()
+            .is_some_and(|g| (i32::from(g.0) - i32::from(h.position.0)).abs() > IN_POSITION_STEPS);
+        h.answering && (h.moving || (recent && far))
     }
 
     /// Powers the arm on: torque on for every servo.
@@ -1082,7 +1122,6 @@ impl Atom {
             speed_percent: 100,
         })?;
         let present = self.present_steps();
-        let accel = motion::joint_accel_register(&self.config);
         let max_speed = u64::from(motion::joint_speed_steps(&self.config, speed_percent));
         let goal_steps: [Steps; JOINTS] = core::array::from_fn(|j| {
             self.config
@@ -1101,10 +1140,14 @@ impl Atom {
         let mut goals: GoalSet = [None; SERVOS];
         for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
             let speed = (travel(j) * 1_000_000 / step_us).clamp(1, max_speed.max(1));
+            // Steps need a brisk ramp (the servo must reach the step speed within a fraction
+            // of a period), scaled by the joint's share like the speed, so every joint follows
+            // the same time-scaled profile and the end stays on the line.
+            let accel = (u64::from(STEP_ACCEL_REGISTER) * travel(j) / longest.max(1)).max(1);
             *slot = goal_steps.get(j).map(|&position| Goal {
                 position,
                 speed_steps_per_s: speed.min(u64::from(u16::MAX)) as u16,
-                accel,
+                accel: accel.min(254) as u8,
             });
         }
         self.send_goals(goals)?;

@@ -448,7 +448,7 @@ fn execute<I: AtomIo>(
             Answer::Done(atom.gripper_to(value.get(), speed.get()))
         }
         R::SetGripperCalibration => Answer::Done(atom.calibrate(GRIPPER)),
-        R::IsGripperMoving => byte(atom.servo_health(GRIPPER).is_some_and(|h| h.moving)),
+        R::IsGripperMoving => byte(atom.servo_moving(GRIPPER)),
         R::SetColor { rgb } => {
             io.set_rgb(rgb.r, rgb.g, rgb.b);
             Answer::Done(Ok(()))
