@@ -157,6 +157,7 @@ fn run_suite(python: &Path, robot: &Robot) -> (bool, String) {
         .env("MYCOBOT_PORT", &robot.link)
         .env("MYCOBOT_TCP", &robot.tcp)
         .env("PYTHONDONTWRITEBYTECODE", "1")
+        .env("PYTHONWARNINGS", "ignore::DeprecationWarning")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()

@@ -116,7 +116,9 @@ class CoordMoveTest(RobotTestCase):
             rel = [p - s for p, s in zip(c[:3], start[:3])]
             along = sum(r * d for r, d in zip(rel, direction)) / length
             off_line = math.sqrt(max(0.0, sum(r * r for r in rel) - along * along))
-            self.assertLessEqual(off_line, 2.0, f"left the straight line at {c}")
+            # A joint-interpolated arc between these poses strays ~10 mm; servo tracking lag
+            # behind the streamed waypoints accounts for ~2 mm.
+            self.assertLessEqual(off_line, 3.0, f"left the straight line at {c}")
             self.assertGreaterEqual(along, -1.0)
             self.assertLessEqual(along, length + 1.0)
         self.assertGreater(len(samples), 3, "too few samples during the linear move")
@@ -141,6 +143,41 @@ class CoordMoveTest(RobotTestCase):
         self.assertLessEqual(position_error_mm(self.mc.get_coords(), before), POS_TOL_MM)
         self.assertEqual(self.mc.clear_error_information(), 1)
         self.assertEqual(self.mc.get_error_information(), 0)
+        self.home()
+
+
+class QueueTest(RobotTestCase):
+    def max_joint1_during(self, first, second):
+        """Sends two moves back to back; returns the largest joint-1 angle seen until rest."""
+        self.assertEqual(self.mc.send_angles(first, 100), 1)
+        self.assertEqual(self.mc.send_angles(second, 100), 1)
+        highest = 0.0
+        deadline = time.monotonic() + MOVE_TIMEOUT
+        while time.monotonic() < deadline:
+            highest = max(highest, self.mc.get_angles()[0])
+            if self._within(self.mc.get_angles(), second, 0.2) and self.mc.is_moving() == 0:
+                return highest
+        self.fail(f"did not reach {second}: at {self.mc.get_angles()}")
+
+    def test_fresh_mode_decides_between_queueing_and_preempting(self):
+        original = self.mc.get_fresh_mode()
+        first, second = [40, 0, 0, 0, 0, 0], [0, 20, 0, 0, 0, 0]
+        try:
+            self.home()
+            self.mc.set_fresh_mode(0)
+            self.assertGreaterEqual(self.max_joint1_during(first, second), 39.8, "queue mode skipped a move")
+            self.home()
+            self.mc.set_fresh_mode(1)
+            self.assertLess(self.max_joint1_during(first, second), 30, "fresh mode did not preempt")
+        finally:
+            self.mc.set_fresh_mode(original)
+        self.home()
+
+    def test_sync_send_angles_returns_once_arrived(self):
+        self.home()
+        target = [-20, 15, -25, 10, 20, -30]
+        self.mc.sync_send_angles(target, 100, timeout=6)
+        self.assertAnglesClose(self.mc.get_angles(), target, tol=0.5, msg="after sync_send_angles")
         self.home()
 
 
