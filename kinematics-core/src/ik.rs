@@ -27,8 +27,7 @@ use crate::transform::{LEN_PER_TENTH_MM, Len, Transform};
 const REACH_TOLERANCE: Len = 2 * LEN_PER_TENTH_MM;
 
 /// How far (2 um) beyond reach a branch may be and still count as exact: the fixed-point
-/// error of a consistent target. Branches clamped by more are approximate and chosen only when
-/// no exact branch fits the limits.
+/// error of a consistent target. Branches clamped by more are [`Fit::Clamped`].
 const EXACT_SLACK: Len = 2 * LEN_PER_TENTH_MM / 100;
 
 /// |sin t5| (Q30, 2.4e-4, i.e. q5 within 0.014 deg of +-90) below which the wrist is singular
@@ -46,17 +45,90 @@ const MAX_WRIST_COORD: Len = 20_000 * LEN_PER_TENTH_MM;
 /// The most branches: shoulder x wrist x elbow.
 pub(crate) const MAX_BRANCHES: usize = 8;
 
+/// How well a branch reaches the target, best first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) enum Fit {
+    /// Reaches it (within the fixed-point error).
+    Exact,
+    /// The target was up to [`REACH_TOLERANCE`] beyond reach and was clamped.
+    Clamped,
+    /// Next to the wrist singularity, the seed's t6 replaced an unreachable exact one: the
+    /// orientation is off by up to |sin t5| times the change of t6 (below 0.4 deg).
+    NearSingular,
+}
+
 /// One IK solution in DH angles.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Branch {
     /// DH angles theta 1..6.
     pub theta: [Angle; 6],
-    /// False if the target was beyond reach by more than [`EXACT_SLACK`] and was clamped.
-    pub exact: bool,
+    /// How well it reaches the target.
+    pub fit: Fit,
 }
 
 /// Each branch that exists, indexed shoulder * 4 + wrist * 2 + elbow.
 pub(crate) type Branches = [Option<Branch>; MAX_BRANCHES];
+
+/// |sin t5| (Q30, 2e-3, q5 within 0.11 deg of +-90) below which a t6 that leaves the target out
+/// of the elbow's reach is replaced by the seed's (then turned into reach), at an orientation
+/// error of at most |sin t5| times the change of t6. Wire rounding alone reaches 3e-4 here.
+const NEAR_SINGULAR_SIN: i64 = 1 << 21;
+
+/// Distance (0.05 mm) kept from the elbow's reach limits when t6 is chosen at the wrist
+/// singularity (covers the d6 * sin t5 the singular model neglects).
+const SINGULAR_REACH_MARGIN: Len = LEN_PER_TENTH_MM / 2;
+
+/// Right shift that brings the squared lengths of [`reachable_turn`] (up to 2^52) to a range
+/// whose squares fit `i64`.
+const TURN_SCALE_SHIFT: u32 = 24;
+
+/// Frame 4 seen from frame 1, given M = A1^-1 * T06: (t2 + t3 + t4, origin x, origin y).
+/// T14 = M * A56^-1, of which only the rotation's first column and the position are needed:
+/// R14 e_x = M.R * (row 0 of R56), p14 = M.p - M.R * R56^T * p56.
+fn frame4(links: &Links, m: &Transform, t5: Angle, t6: Angle) -> (Angle, Len, Len) {
+    let a56 = links.link(4, t5).then(&links.link(5, t6));
+    let r56 = &a56.rotation;
+    let [x14_x, x14_y, _] = m
+        .rotation
+        .apply(&[r56.at(0, 0), r56.at(0, 1), r56.at(0, 2)]);
+    let [bx, by, _] = m.rotation.apply(&r56.transpose().apply(&a56.position));
+    (atan2(x14_y, x14_x), m.position[0] - bx, m.position[1] - by)
+}
+
+/// At the wrist singularity the frame-4 origin e = c + d5 (-sin t234, cos t234) moves on a
+/// circle about c as t6 (and with it t234) turns. The smallest change of t234 that brings |e|
+/// into [lo, hi], or `None` if no point of the circle is.
+fn reachable_turn(ex: Len, ey: Len, t234: Angle, d5: Len, lo: Len, hi: Len) -> Option<Angle> {
+    let (s, c) = t234.sin_cos();
+    let (cx, cy) = (ex + mul(d5, s), ey - mul(d5, c));
+    let c_len = sqrt(cx * cx + cy * cy);
+    if c_len == 0 {
+        return None;
+    }
+    // |e|^2 = |c|^2 + d5^2 + 2 d5 |c| cos(u), u = t234 + 90 deg - angle of c.
+    let u = t234.add(Angle::QUARTER).sub(atan2(cy, cx));
+    let base = c_len * c_len + d5 * d5;
+    let den = (2 * d5 * c_len) >> TURN_SCALE_SHIFT;
+    // The |u| (binary angle) where |e| = `len`: acos((len^2 - base) / den), clamped.
+    let bound = |len: Len| -> i64 {
+        let num = (len * len - base) >> TURN_SCALE_SHIFT;
+        if num >= den {
+            0
+        } else if num <= -den {
+            1 << 31
+        } else {
+            i64::from(atan2(sqrt(den * den - num * num), num).0).abs()
+        }
+    };
+    let (u_min, u_max) = (bound(hi), bound(lo.max(0)));
+    if u_min > u_max {
+        return None;
+    }
+    let now = i64::from(u.0).abs();
+    let wanted = now.clamp(u_min, u_max);
+    let turn = if u.0 < 0 { now - wanted } else { wanted - now };
+    Some(Angle(turn as i32))
+}
 
 /// Whether `low <= sqrt(v) <= high` (lengths), with `low` clamped at zero.
 fn within(v: i64, low: Len, high: Len) -> bool {
@@ -71,7 +143,7 @@ pub(crate) fn solve(
     target: &Transform,
     seed_theta6: Angle,
 ) -> Result<Branches, IkError> {
-    let [_, _, _, d4, _, d6] = links.d;
+    let [_, _, _, d4, d5, d6] = links.d;
     let [_, a2, a3, _, _, _] = links.a;
     let r = &target.rotation;
     let z = r.column(2);
@@ -103,28 +175,48 @@ pub(crate) fn solve(
         let m = links.link(0, t1).inverse().then(target);
         for (wrist, sign5) in [1i64, -1].into_iter().enumerate() {
             let t5 = atan2(sign5 * s5, c5);
-            let t6 = if s5 < WRIST_SINGULAR_SIN {
+            let free_t6 = s5 < WRIST_SINGULAR_SIN;
+            let mut t6 = if free_t6 {
                 seed_theta6
             } else {
                 let sin6 = mul(c1, r.at(1, 1)) - mul(s1, r.at(0, 1));
                 let cos6 = mul(s1, r.at(0, 0)) - mul(c1, r.at(1, 0));
                 atan2(sign5 * sin6, sign5 * cos6)
             };
-            // T14 = M * A56^-1; only its rotation's first column and position are needed:
-            // R14 e_x = M.R * (row 0 of R56), p14 = M.p - M.R * R56^T * p56.
-            let a56 = links.link(4, t5).then(&links.link(5, t6));
-            let r56 = &a56.rotation;
-            let [x14_x, x14_y, _] = m
-                .rotation
-                .apply(&[r56.at(0, 0), r56.at(0, 1), r56.at(0, 2)]);
-            let [bx, by, _] = m.rotation.apply(&r56.transpose().apply(&a56.position));
-            let t234 = atan2(x14_y, x14_x);
-            let (ex, ey) = (m.position[0] - bx, m.position[1] - by);
+            let (mut t234, mut ex, mut ey) = frame4(links, &m, t5, t6);
+            // Near the wrist singularity t6 moves the frame-4 origin on a d5 circle. If this t6
+            // puts it out of the elbow's reach by more than the wire's 0.1 mm (which the reach
+            // clamp absorbs), treat t6 as free: start from the seed's and turn to the nearest
+            // t6 that reaches. Inside the singular band that is exact; in the near band it is
+            // the fallback for poses whose rounding made them unreachable.
+            let slack = LEN_PER_TENTH_MM;
+            let mut approximate_wrist = false;
+            if s5 < NEAR_SINGULAR_SIN && !within(ex * ex + ey * ey, d_len - slack, s_len + slack) {
+                if !free_t6 {
+                    t6 = seed_theta6;
+                    approximate_wrist = true;
+                    (t234, ex, ey) = frame4(links, &m, t5, t6);
+                }
+                let (lo, hi) = (d_len + SINGULAR_REACH_MARGIN, s_len - SINGULAR_REACH_MARGIN);
+                if !within(ex * ex + ey * ey, d_len - slack, s_len + slack)
+                    && let Some(turn) = reachable_turn(ex, ey, t234, d5, lo, hi)
+                {
+                    // At t5 = 0, t234 + t6 is fixed; at t5 = 180 deg, t234 - t6 is.
+                    t6 = if c5 >= 0 { t6.sub(turn) } else { t6.add(turn) };
+                    (t234, ex, ey) = frame4(links, &m, t5, t6);
+                }
+            }
             let l2 = ex * ex + ey * ey;
             if !within(l2, d_len - REACH_TOLERANCE, s_len + REACH_TOLERANCE) {
                 continue;
             }
-            let exact = shoulder_exact && within(l2, d_len - EXACT_SLACK, s_len + EXACT_SLACK);
+            let fit = if approximate_wrist {
+                Fit::NearSingular
+            } else if shoulder_exact && within(l2, d_len - EXACT_SLACK, s_len + EXACT_SLACK) {
+                Fit::Exact
+            } else {
+                Fit::Clamped
+            };
             if l2 == 0 {
                 degenerate = true;
                 continue;
@@ -140,7 +232,7 @@ pub(crate) fn solve(
                 if let Some(slot) = out.get_mut(shoulder * 4 + wrist * 2 + elbow) {
                     *slot = Some(Branch {
                         theta: [t1, t2, t3, t4, t5, t6],
-                        exact,
+                        fit,
                     });
                 }
             }

@@ -156,20 +156,21 @@ impl Kinematics {
     ) -> Result<JointAngles, IkError> {
         let seed_theta6 = self.links.theta(5, seed.0[5]);
         let branches = ik::solve(&self.links, &self.flange_of(target), seed_theta6)?;
-        // Exact branches first, then clamped ones (target just out of reach); nearest the seed.
+        // The best fit first (exact, clamped, near-singular), then the nearest to the seed.
         branches
             .iter()
             .flatten()
-            .filter_map(|b| Some((self.in_limits_near(&b.theta, seed)?, !b.exact)))
-            .min_by_key(|((_, distance), clamped)| (*clamped, *distance))
+            .filter_map(|b| Some((self.in_limits_near(&b.theta, seed)?, b.fit)))
+            .min_by_key(|((_, distance), fit)| (*fit, *distance))
             .map(|((q, _), _)| q)
             .ok_or(IkError::OutsideLimits)
     }
 
     /// Every branch for `target` as joint angles wrapped into the limits near `seed` (`None` for
     /// a branch that does not exist or does not fit the limits), indexed
-    /// shoulder * 4 + wrist * 2 + elbow. Branches that reach the target only by clamping it
-    /// (up to 0.2 mm beyond reach) are listed only when no branch reaches it exactly.
+    /// shoulder * 4 + wrist * 2 + elbow. Only the branches of the best fit are listed: those that
+    /// reach the target exactly, else those that clamp it (up to 0.2 mm beyond reach), else
+    /// those next to the wrist singularity that trade a little orientation for reach.
     pub fn inverse_all(
         &self,
         target: &Pose,
@@ -189,9 +190,9 @@ impl Kinematics {
             &self.flange_of(target),
             self.links.theta(5, seed.0[5]),
         )?;
-        let any_exact = branches.iter().flatten().any(|b| b.exact);
+        let best = branches.iter().flatten().map(|b| b.fit).min();
         Ok(branches.map(|b| {
-            b.filter(|b| b.exact || !any_exact)
+            b.filter(|b| Some(b.fit) == best)
                 .and_then(|b| self.in_limits_near(&b.theta, seed))
                 .map(|(q, _)| q)
         }))

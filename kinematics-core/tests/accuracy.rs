@@ -327,24 +327,37 @@ fn every_branch_reaches_the_target() {
 fn singular_poses_solve() {
     let kin = Kinematics::new();
     for q in [
-        [0, 0, 0, 0, 0, 0],             // zero pose: elbow and shoulder singular
-        [3000, 0, 0, 0, 9000, 4500],    // stretched and wrist singular
-        [0, 4000, 0, -2000, -9000, 0],  // stretched, wrist singular
-        [1000, 2000, 3000, 0, 9000, 0], // wrist singular only
+        [0, 0, 0, 0, 0, 0],                      // zero pose: elbow and shoulder singular
+        [3000, 0, 0, 0, 9000, 4500],             // stretched and wrist singular
+        [0, 4000, 0, -2000, -9000, 0],           // stretched, wrist singular
+        [1000, 2000, 3000, 0, 9000, 0],          // wrist singular only
+        [7545, 2264, 4119, -3988, 9000, -13001], // wrist singular, J6 far from zero
+        [-6000, -3000, 1500, 7000, -9000, 17000],
     ] {
         let q = JointAngles(q);
         let target = kin.forward(&q);
-        let sol = kin
-            .inverse(&target, &q)
-            .unwrap_or_else(|e| panic!("{q:?}: {e:?}"));
-        let (mm, deg) = distance(&fk_f64(&to_deg(&sol)), &pose_f64(&target));
-        assert!(
-            mm <= 0.1 && deg <= 0.05,
-            "{q:?} -> {sol:?}: {mm} mm {deg} deg"
-        );
-        // At the wrist singularity J6 keeps the seed's value.
-        if q.0[4].abs() == 9000 {
-            assert!((sol.0[5] - q.0[5]).abs() <= 2, "{sol:?}");
+        // Seeded with the configuration itself, with zero, and with J6 half a turn away: at the
+        // wrist singularity J6 is free, and a seed whose J6 puts the elbow out of reach must
+        // still find a solution.
+        let mut flipped = q;
+        flipped.0[5] = if q.0[5] > 0 {
+            q.0[5] - 18_000
+        } else {
+            q.0[5] + 18_000
+        };
+        for seed in [q, JointAngles::default(), flipped] {
+            let sol = kin
+                .inverse(&target, &seed)
+                .unwrap_or_else(|e| panic!("{q:?} seed {seed:?}: {e:?}"));
+            let (mm, deg) = distance(&fk_f64(&to_deg(&sol)), &pose_f64(&target));
+            assert!(
+                mm <= 0.1 && deg <= 0.05,
+                "{q:?} seed {seed:?} -> {sol:?}: {mm} mm {deg} deg"
+            );
+            // At the wrist singularity J6 keeps the seed's value when it can.
+            if seed == q && q.0[4].abs() == 9000 {
+                assert!((sol.0[5] - q.0[5]).abs() <= 2, "{sol:?}");
+            }
         }
     }
 }
