@@ -8,9 +8,15 @@
 //! request's CMD byte counts as the reply; servo packets, other frames and late duplicates are
 //! dropped, and a request that gets no reply is given up after its deadline so the next one can
 //! go. Requests wait in a bounded queue meanwhile.
+//!
+//! A reply garbled on the wire (a frame header `FE FE` heard, but no valid frame) is lost for
+//! good: the Atom does not know. The Basic then sends the request again at once, instead of
+//! leaving the host to wait 0.5 s and resend it itself - unless repeating it could move the
+//! arm twice ([`is_repeatable`]: the incremental jogs 0x33 and 0x34).
 
 use heapless::{Deque, Vec};
-use protocol_core::frame::MAX_FRAME_BYTES;
+use protocol_core::command::cmd;
+use protocol_core::frame::{HEADER, MAX_FRAME_BYTES};
 use protocol_core::{BytePort, Frame, FrameDecoder, timing};
 
 use crate::config::{BasicConfig, EchoMode};
@@ -25,6 +31,16 @@ pub const REQUEST_QUEUE_DEPTH: usize = 8;
 pub const ECHO_GRACE_US: u64 = 20;
 /// Longest back-off after a collision, in microseconds.
 pub const MAX_BACKOFF_US: u64 = 2_000;
+
+/// True if sending `request` to the Atom twice does no harm: everything but the incremental
+/// jogs (0x33 jog increment angle, 0x34 jog increment coord / jog stop), which would move the
+/// arm twice as far.
+pub fn is_repeatable(request: &Frame) -> bool {
+    !matches!(
+        request.cmd(),
+        cmd::JOG_INCREMENT_ANGLE | cmd::JOG_INCREMENT_COORD
+    )
+}
 
 /// Who asked for a request, and so where its reply goes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,8 +85,14 @@ enum Stage {
         collided: bool,
         tx_done_us: Option<u64>,
     },
-    /// Sent; waiting for the reply until `deadline_us`.
-    AwaitReply { deadline_us: u64 },
+    /// Sent; waiting for the reply until `deadline_us`. `last_fe` is whether the last byte
+    /// heard was `FE`; `header_open` whether a `FE FE` header has been heard that no valid
+    /// frame has completed yet.
+    AwaitReply {
+        deadline_us: u64,
+        last_fe: bool,
+        header_open: bool,
+    },
 }
 
 #[derive(Debug)]
@@ -172,10 +194,31 @@ impl Forwarder {
             // Not our echo: somebody else talked while we did.
             *collided = true;
         }
+        if let Some(InFlight {
+            stage:
+                Stage::AwaitReply {
+                    last_fe,
+                    header_open,
+                    ..
+                },
+            ..
+        }) = &mut self.current
+        {
+            *header_open |= *last_fe && byte == HEADER;
+            *last_fe = byte == HEADER && !*last_fe;
+        }
         let mut next = self.decoder.push(byte);
         while let Some(frame) = next {
             self.on_frame(frame, &mut on_event);
             next = self.decoder.next_frame();
+        }
+        let garbled = matches!(
+            &self.current,
+            Some(InFlight { stage: Stage::AwaitReply { header_open: true, .. }, request, .. })
+                if is_repeatable(&request.frame)
+        ) && !self.decoder.has_partial();
+        if garbled {
+            self.on_collision(now_us, config, &mut on_event);
         }
     }
 
@@ -199,7 +242,7 @@ impl Forwarder {
         }
         self.check_transmission(now_us, bus, config, &mut on_event);
         if let Some(InFlight {
-            stage: Stage::AwaitReply { deadline_us },
+            stage: Stage::AwaitReply { deadline_us, .. },
             ..
         }) = &self.current
             && now_us >= *deadline_us
@@ -305,6 +348,8 @@ impl Forwarder {
             };
             flight.stage = Stage::AwaitReply {
                 deadline_us: now_us.saturating_add(timeout_us),
+                last_fe: false,
+                header_open: false,
             };
         }
     }
@@ -344,6 +389,14 @@ impl Forwarder {
                 reply: frame,
             });
         } else {
+            if let Some(InFlight {
+                stage: Stage::AwaitReply { header_open, .. },
+                ..
+            }) = &mut self.current
+            {
+                // That header belonged to this valid frame.
+                *header_open = false;
+            }
             on_event(Event::Unsolicited);
         }
     }

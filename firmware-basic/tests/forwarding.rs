@@ -318,3 +318,43 @@ fn an_atom_answering_right_after_the_request_is_not_mistaken_for_a_broken_echo()
         assert_eq!(rig.basic.status().collisions, 0, "echo {echo}");
     }
 }
+
+/// An Atom whose first reply to each request is garbled on the wire (as by noise).
+fn garbling_atom() -> common::Responder {
+    let mut n = 0;
+    Box::new(move |f: &Frame| {
+        n += 1;
+        let mut reply = frame(f.cmd(), &[1]);
+        if n % 2 == 1 {
+            reply[2] ^= 0x5A;
+        }
+        Some(reply)
+    })
+}
+
+#[test]
+fn a_garbled_reply_makes_the_basic_ask_again_at_once() {
+    for echo in [true, false] {
+        let mut rig = Rig::quiet(echo);
+        rig.atom = garbling_atom();
+        rig.host.send(&frame(IS_POWERED_ON, &[]));
+        rig.run_us(5_000);
+        assert_eq!(rig.atom_got.len(), 2, "echo {echo}");
+        assert_eq!(
+            rig.host.received(),
+            frame(IS_POWERED_ON, &[1]),
+            "echo {echo}"
+        );
+    }
+}
+
+#[test]
+fn an_incremental_jog_is_never_sent_twice() {
+    let mut rig = Rig::quiet(true);
+    rig.atom = garbling_atom();
+    // Jog joint 1 by +10 degrees at speed 50.
+    rig.host.send(&frame(0x33, &[1, 0x03, 0xE8, 50]));
+    rig.run_us(BasicConfig::default().reply_timeout_us + 10_000);
+    assert_eq!(rig.atom_got.len(), 1);
+    assert!(rig.host.received().is_empty());
+}
