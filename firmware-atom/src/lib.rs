@@ -5,6 +5,35 @@
 //! the user pins, and runs the kinematics. Everything here is a state machine polled with the
 //! time ([`Atom::poll`]); the board layer (`src/bin`) and the virtual robot bind the traits
 //! ([`protocol_core::BytePort`], [`AtomIo`]) to hardware or to a simulation.
+//!
+//! # Behaviour a client sees
+//! * **Replies.** Every request gets exactly one reply with its CMD byte, sent as soon as the
+//!   request's last byte is in (from cached state); only get servo data (0x53) waits for a servo
+//!   read (bounded by the retries below). Set commands answer `01` when accepted and `00` when
+//!   refused; a refusal changes nothing and, where `protocol.md` has a code, records it for
+//!   0x07 (1..6 joint limit, 32 unreachable pose, 33/34 linear move). Invalid frames (unknown
+//!   code, wrong length, value out of range) answer `00`.
+//! * **State** (angles, coords, encoders, speeds, voltages, temperatures, faults) comes from
+//!   the servos: every servo's 15-byte state block is read in turn, about 280 rounds per second
+//!   (bench `latency`). Coordinates are the forward kinematics of the present angles.
+//! * **Safety.** Every position goal passes one check ([`safety::check`]): power on, joint
+//!   limits (settable with 0x4C/0x4D), encoder range. No path bypasses it.
+//! * **Motion.** Joint moves scale each joint's speed and ramp by its share of the longest
+//!   travel, so all joints arrive together. Coordinate moves are joint-interpolated (mode 0) or
+//!   stepped along a straight line every 20 ms (mode 1). Fresh mode (default 1) lets a new move
+//!   replace the current one; mode 0 queues up to 16 moves.
+//! * **Jog watchdog.** A continuous jog (0x30..0x32) stops when no host command has arrived
+//!   for 2 s ([`TimingBudget::jog_watchdog_us`]): pymycobot has no keep-alive, so a script
+//!   that jogs, sleeps a second and stops still works, while a lost link moves a joint for at
+//!   most 2 s. Jog stop (0x34 LEN 2), stop (0x29) or any new motion end it earlier.
+//! * **Gripper** (servo 7): value 0 (closed) ..= 100 (open) maps linearly onto the encoder
+//!   range [`config::GripperRange`] (default 2048 ..= 3072); calibration (0x68) makes the
+//!   present position the new closed end (the servo's present position becomes 2048).
+//! * **Servo health.** A servo that misses 3 state reads in a row is reported not answering
+//!   (0x50, 0x51, 0x15 code 16) and then probed only every 8th round, so it costs the others
+//!   almost nothing; fault bits show in 0xE4 and 0x15 (32 + bits).
+//! * **Free mode** (0x1A 1): holding the Atom's button releases the joints so the arm can be
+//!   moved by hand; letting go holds it where it is.
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 

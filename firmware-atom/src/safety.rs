@@ -1,4 +1,5 @@
-//! The one choke point every servo goal passes: joint limits, gripper range and power state.
+//! The one choke point every servo goal passes: joint limits, gripper encoder range and power
+//! state.
 //!
 //! [`SafeGoals`] can only be made by [`check`], and the Atom sends position goals to servos
 //! only from a `SafeGoals` (`Atom::send_goals`): no command path (move, jog, linear
@@ -7,7 +8,7 @@
 use protocol_core::servo::{SyncWriteBuilder, reg, to_sign_magnitude};
 use protocol_core::units::{Centideg, Steps};
 
-use crate::config::{AtomConfig, GRIPPER, JOINTS, JointLimit, SERVOS};
+use crate::config::{AtomConfig, GRIPPER, JOINTS, JointLimit, SERVOS, STEPS_PER_TURN};
 
 /// A goal for one servo: where to go and how (the STS move block).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,7 +42,7 @@ pub enum Refusal {
     PoweredOff,
     /// Joint `index` (0-based) would leave its limits.
     JointLimit(usize),
-    /// The gripper goal is outside its calibrated range.
+    /// The gripper goal is not an encoder position (0..4095).
     GripperRange,
 }
 
@@ -85,11 +86,12 @@ pub fn check(
             return Err(Refusal::JointLimit(j));
         }
     }
-    if let Some(Some(g)) = goals.get(GRIPPER) {
-        let (a, b) = (config.gripper.closed.0, config.gripper.open.0);
-        if !(a.min(b)..=a.max(b)).contains(&g.position.0) {
-            return Err(Refusal::GripperRange);
-        }
+    // The gripper has no angle limits: its goals only have to be encoder positions (clients
+    // set it by raw encoder, e.g. 0x3A servo 7, beyond the 0..100 value range).
+    if let Some(Some(g)) = goals.get(GRIPPER)
+        && !(0..STEPS_PER_TURN as i16).contains(&g.position.0)
+    {
+        return Err(Refusal::GripperRange);
     }
     Ok(SafeGoals(goals))
 }
@@ -138,7 +140,7 @@ mod tests {
         let cfg = AtomConfig::default();
         let mut goals: GoalSet = [None; SERVOS];
         goals[GRIPPER] = Some(Goal {
-            position: Steps(100),
+            position: Steps(4096),
             speed_steps_per_s: 100,
             accel: 10,
         });
