@@ -4,10 +4,12 @@
 //! * [`pty`]: a raw pseudo-terminal standing in for the Basic's USB serial port;
 //! * [`pty_link`]: a stable symlink to it (`--pty-link`);
 //! * [`tcp`]: the host protocol over TCP, like the Basic's Wi-Fi server (`--tcp`);
+//! * [`pacer`]: client input paced to the serial line's speed, as a real port does;
 //! * [`realtime`]: the loop that runs the robot at wall-clock speed and moves the bytes;
 //! * [`cli`]: the command line.
 
 pub mod cli;
+pub mod pacer;
 pub mod pty;
 pub mod pty_link;
 pub mod realtime;

@@ -17,8 +17,11 @@ use std::time::{Duration, Instant};
 use nix::poll::{PollFd, PollFlags, ppoll};
 use nix::sys::time::TimeSpec;
 
+use protocol_core::timing::HOST_BAUD;
+
 use crate::sim::{HostLink, VirtualRobot};
 
+use super::pacer::{LinePacer, WINDOW_BYTES};
 use super::pty::PseudoTerminal;
 use super::tcp::{ClientId, TcpServer};
 
@@ -84,6 +87,7 @@ pub struct RealtimeDriver<R> {
     pty: PseudoTerminal,
     tcp: Option<TcpServer>,
     talker: Talker,
+    pacer: LinePacer,
 }
 
 impl<R: RealtimeRobot> RealtimeDriver<R> {
@@ -94,6 +98,7 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             pty,
             tcp,
             talker: Talker::Pty,
+            pacer: LinePacer::new(HOST_BAUD, WINDOW_BYTES),
         }
     }
 
@@ -117,7 +122,8 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
         let mut output = Vec::with_capacity(256);
         while !stop.load(Ordering::Relaxed) {
             let active = last_traffic.is_some_and(|t| t.elapsed() < ACTIVE_SPELL);
-            self.wait_for_input(if active { ACTIVE_TICK } else { IDLE_TICK })?;
+            let line_full = self.pacer.room(self.robot.now_us().saturating_mul(1_000)) == 0;
+            self.wait_for_input(if active { ACTIVE_TICK } else { IDLE_TICK }, !line_full)?;
 
             let mut target_us = virtual_at_sync.saturating_add(micros(wall_sync.elapsed()));
             if target_us > self.robot.now_us() + micros(MAX_CATCH_UP) {
@@ -141,11 +147,13 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
         Ok(self.robot)
     }
 
-    /// Sleeps until a client sends something or `tick` passes.
-    fn wait_for_input(&self, tick: Duration) -> io::Result<()> {
+    /// Sleeps until a client sends something (if `watch_clients`) or `tick` passes. While the
+    /// line is full the clients are not watched: their pending bytes would wake us at once.
+    fn wait_for_input(&self, tick: Duration, watch_clients: bool) -> io::Result<()> {
         let pty_fd: BorrowedFd<'_> = std::os::fd::AsFd::as_fd(&self.pty);
         let mut fds: Vec<PollFd<'_>> = std::iter::once(pty_fd)
             .chain(self.tcp.iter().flat_map(TcpServer::poll_fds))
+            .filter(|_| watch_clients)
             .map(|fd| PollFd::new(fd, PollFlags::POLLIN))
             .collect();
         match ppoll(&mut fds, Some(TimeSpec::from_duration(tick)), None) {
@@ -154,15 +162,23 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
         }
     }
 
-    /// Hands everything clients sent to the robot; tells whether there was anything.
+    /// Hands what clients sent to the robot, as much as the line can carry now (see
+    /// [`LinePacer`]); tells whether there was anything.
     fn forward_client_input(&mut self, buf: &mut [u8]) -> io::Result<bool> {
+        let now_ns = self.robot.now_us().saturating_mul(1_000);
+        let mut budget = self.pacer.room(now_ns);
         let mut any = false;
-        loop {
-            let n = self.pty.read_available(buf)?;
-            let Some(bytes) = buf.get(..n).filter(|b| !b.is_empty()) else {
+        while let Some(window) = buf
+            .get_mut(..budget.min(buf.len()))
+            .filter(|w| !w.is_empty())
+        {
+            let n = self.pty.read_available(window)?;
+            let Some(bytes) = window.get(..n).filter(|b| !b.is_empty()) else {
                 break;
             };
             self.robot.host_write(bytes);
+            self.pacer.consumed(n, now_ns);
+            budget -= n;
             self.talker = Talker::Pty;
             any = true;
         }
@@ -170,8 +186,10 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             tcp.accept_pending();
             let robot = &mut self.robot;
             let talker = &mut self.talker;
-            tcp.receive(|id, bytes| {
+            let pacer = &mut self.pacer;
+            tcp.receive(budget, |id, bytes| {
                 robot.host_write(bytes);
+                pacer.consumed(bytes.len(), now_ns);
                 *talker = Talker::Tcp(id);
                 any = true;
             });
@@ -327,5 +345,58 @@ mod tests {
             "advanced {largest} us at once"
         );
         assert_eq!(robot.advances_us.len(), 50);
+    }
+
+    /// Checks on every write that no more arrived than the 115200 line could carry.
+    struct CountingRobot {
+        now_us: u64,
+        received: usize,
+        expected: usize,
+        stop: Arc<AtomicBool>,
+    }
+
+    impl RealtimeRobot for CountingRobot {
+        fn now_us(&self) -> u64 {
+            self.now_us
+        }
+        fn host_write(&mut self, bytes: &[u8]) {
+            self.received += bytes.len();
+            let byte_ns = protocol_core::timing::wire_time_ns(1, HOST_BAUD);
+            let carried = WINDOW_BYTES as u64 + self.now_us * 1_000 / byte_ns + 1;
+            assert!(
+                self.received as u64 <= carried,
+                "{} bytes handed over by {} us: faster than 115200 baud",
+                self.received,
+                self.now_us
+            );
+            if self.received >= self.expected {
+                self.stop.store(true, Ordering::Relaxed);
+            }
+        }
+        fn host_read(&mut self, _: &mut Vec<u8>) {}
+        fn run_until(&mut self, t_us: u64) {
+            self.now_us = t_us;
+        }
+    }
+
+    #[test]
+    fn a_flooding_client_is_paced_to_the_line_speed_and_nothing_is_lost() {
+        let stop = Arc::new(AtomicBool::new(false));
+        let flood = vec![0x55u8; 2_000];
+        let robot = CountingRobot {
+            now_us: 0,
+            received: 0,
+            expected: flood.len(),
+            stop: Arc::clone(&stop),
+        };
+        let driver = RealtimeDriver::new(robot, PseudoTerminal::open().unwrap(), None);
+        let mut client = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(driver.pty().slave_path())
+            .unwrap();
+        client.write_all(&flood).unwrap();
+        let robot = driver.run(&stop).unwrap();
+        assert_eq!(robot.received, flood.len());
     }
 }

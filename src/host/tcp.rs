@@ -89,20 +89,25 @@ impl TcpServer {
         }
     }
 
-    /// Reads whatever each client sent, handing it to `on_bytes`; drops clients that closed
+    /// Reads up to `budget` bytes of what clients sent, handing them to `on_bytes`; the rest
+    /// waits in the kernel (TCP flow control slows the client). Drops clients that closed
     /// their connection or failed.
-    pub fn receive(&mut self, mut on_bytes: impl FnMut(ClientId, &[u8])) {
+    pub fn receive(&mut self, mut budget: usize, mut on_bytes: impl FnMut(ClientId, &[u8])) {
         let mut buf = [0u8; 1024];
         self.clients.retain_mut(|client| {
-            loop {
-                match client.stream.read(&mut buf) {
+            while let Some(window) = buf.get_mut(..budget.min(1024)).filter(|w| !w.is_empty()) {
+                match client.stream.read(window) {
                     Ok(0) => return false,
-                    Ok(n) => on_bytes(client.id, buf.get(..n).unwrap_or_default()),
+                    Ok(n) => {
+                        budget -= n;
+                        on_bytes(client.id, window.get(..n).unwrap_or_default());
+                    }
                     Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
                     Err(e) if e.kind() == io::ErrorKind::WouldBlock => return true,
                     Err(_) => return false,
                 }
             }
+            true
         });
     }
 
@@ -152,7 +157,7 @@ mod tests {
         let mut got: Vec<(ClientId, Vec<u8>)> = Vec::new();
         while got.iter().map(|(_, b)| b.len()).sum::<usize>() < want && Instant::now() < deadline {
             server.accept_pending();
-            server.receive(|id, bytes| got.push((id, bytes.to_vec())));
+            server.receive(usize::MAX, |id, bytes| got.push((id, bytes.to_vec())));
             std::thread::sleep(Duration::from_millis(1));
         }
         got
@@ -195,7 +200,7 @@ mod tests {
         drop(first);
         let deadline = Instant::now() + Duration::from_secs(2);
         while server.client_count() == 2 && Instant::now() < deadline {
-            server.receive(|_, _| {});
+            server.receive(usize::MAX, |_, _| {});
         }
         assert_eq!(server.client_count(), 1);
 
