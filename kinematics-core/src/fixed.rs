@@ -103,25 +103,31 @@ pub const fn mul(a: i64, b: i64) -> i64 {
     (a * b) >> 30
 }
 
-/// sin(x) for |x| <= pi/4 rad, x and result in Q30 (Taylor to x^11: error < 1e-11).
-fn sin_small(x: i64) -> i64 {
-    let x2 = mul(x, x);
-    let mut t = ONE - x2 / 110;
-    t = ONE - mul(x2, t) / 72;
-    t = ONE - mul(x2, t) / 42;
-    t = ONE - mul(x2, t) / 20;
-    t = ONE - mul(x2, t) / 6;
-    mul(x, t)
+/// Taylor coefficients of sin: round((-1)^k / (2k+1)! * 2^30) for k = 1..=5.
+const SIN_TAYLOR: [i64; 5] = [-178_956_971, 8_947_849, -213_044, 2_959, -27];
+/// Taylor coefficients of cos: round((-1)^k / (2k)! * 2^30) for k = 1..=5.
+const COS_TAYLOR: [i64; 5] = [-536_870_912, 44_739_243, -1_491_308, 26_631, -296];
+
+/// 1 + c1 x2 + c2 x2^2 + ... (Horner), Q30.
+#[inline]
+fn even_series(x2: i64, coefficients: &[i64; 5]) -> i64 {
+    let [c1, c2, c3, c4, c5] = *coefficients;
+    let mut t = c5;
+    t = c4 + mul(x2, t);
+    t = c3 + mul(x2, t);
+    t = c2 + mul(x2, t);
+    t = c1 + mul(x2, t);
+    ONE + mul(x2, t)
 }
 
-/// cos(x) for |x| <= pi/4 rad, x and result in Q30 (Taylor to x^10: error < 2e-10).
+/// sin(x) for |x| <= pi/4 rad, x and result in Q30 (Taylor to x^11: truncation < 1e-11).
+fn sin_small(x: i64) -> i64 {
+    mul(x, even_series(mul(x, x), &SIN_TAYLOR))
+}
+
+/// cos(x) for |x| <= pi/4 rad, x and result in Q30 (Taylor to x^10: truncation < 2e-10).
 fn cos_small(x: i64) -> i64 {
-    let x2 = mul(x, x);
-    let mut t = ONE - x2 / 90;
-    t = ONE - mul(x2, t) / 56;
-    t = ONE - mul(x2, t) / 30;
-    t = ONE - mul(x2, t) / 12;
-    ONE - mul(x2, t) / 2
+    even_series(mul(x, x), &COS_TAYLOR)
 }
 
 /// Bits to keep in the larger operand of [`atan2`] so that `min << 30` fits an `i64`.

@@ -41,14 +41,28 @@ impl JointLimits {
     /// the limits, choosing the value nearest `seed_centideg`; `None` if no multiple fits.
     pub fn wrap_into(&self, joint: usize, q_centideg: i32, seed_centideg: i32) -> Option<i32> {
         let (lo, hi) = (*self.min.get(joint)?, *self.max.get(joint)?);
-        [
-            q_centideg - TURN_CENTIDEG,
-            q_centideg,
-            q_centideg + TURN_CENTIDEG,
-        ]
-        .into_iter()
-        .filter(|v| (lo..=hi).contains(v))
-        .min_by_key(|v| (i64::from(*v) - i64::from(seed_centideg)).abs())
+        // The multiple of a turn that brings q nearest the seed, then the neighbours on either
+        // side in case that one is outside the limits.
+        // (A seed outside the limits counts as the nearest limit.)
+        let (q, seed) = (
+            i64::from(q_centideg),
+            i64::from(seed_centideg.clamp(lo, hi.max(lo))),
+        );
+        let turn = i64::from(TURN_CENTIDEG);
+        let nearest = q + (seed - q + turn / 2).div_euclid(turn) * turn;
+        let fits = |v: i64| v >= i64::from(lo) && v <= i64::from(hi);
+        let below = nearest - turn;
+        let above = nearest + turn;
+        let pick = if fits(nearest) {
+            nearest
+        } else if fits(below) && (!fits(above) || seed - below <= above - seed) {
+            below
+        } else if fits(above) {
+            above
+        } else {
+            return None;
+        };
+        i32::try_from(pick).ok()
     }
 }
 
@@ -88,5 +102,8 @@ mod tests {
         assert_eq!(wide.wrap_into(0, -17_000, 18_500), Some(19_000));
         // J1 +-168: 170 deg does not fit at any multiple of a turn.
         assert_eq!(l.wrap_into(0, 17_000, 0), None);
+        // A seed far outside the limits still finds the in-limit value.
+        assert_eq!(l.wrap_into(0, 10_000, i32::MAX), Some(10_000));
+        assert_eq!(wide.wrap_into(0, 10_000, i32::MIN), Some(-26_000));
     }
 }
