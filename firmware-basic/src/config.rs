@@ -1,4 +1,5 @@
-//! Settings of the transponder. [`BasicConfig::default`] is the real board.
+//! Settings of the transponder. [`BasicConfig::default`] is the real board; a changed config
+//! is checked once with [`BasicConfig::validate`].
 
 use protocol_core::timing;
 
@@ -16,7 +17,7 @@ pub enum EchoMode {
     Absent,
 }
 
-/// Settings of the transponder.
+/// Settings of the transponder. Times in microseconds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BasicConfig {
     /// How the bus echo is handled.
@@ -26,7 +27,7 @@ pub struct BasicConfig {
     pub reply_timeout_us: u64,
     /// How long an internal request (power-on, probe) waits for its reply, in microseconds.
     pub probe_timeout_us: u64,
-    /// Transmissions of one frame before it is given up after collisions (at least 1).
+    /// Transmissions of one request before it is given up after collisions (at least 1).
     pub max_send_attempts: u8,
     /// Time after power-up before the Basic powers the Atom on (0x10), in microseconds; the
     /// Atom boots in parallel and must be listening.
@@ -52,5 +53,60 @@ impl Default for BasicConfig {
             power_on_at_boot: true,
             version_x10: 10,
         }
+    }
+}
+
+/// A [`BasicConfig`] that cannot work.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ConfigError {
+    /// `reply_timeout_us` is 0, or not shorter than pymycobot's resend deadline (0.5 s): the
+    /// host's resend would queue behind the request it repeats, and get its reply too.
+    ReplyTimeout,
+    /// `probe_timeout_us` is 0 or longer than `reply_timeout_us`.
+    ProbeTimeout,
+    /// `max_send_attempts` is 0: nothing would ever be sent.
+    NoSendAttempts,
+}
+
+impl BasicConfig {
+    /// The config, if it can work.
+    pub fn validate(self) -> Result<Self, ConfigError> {
+        if self.reply_timeout_us == 0 || self.reply_timeout_us >= timing::HOST_REPLY_DEADLINE_US {
+            return Err(ConfigError::ReplyTimeout);
+        }
+        if self.probe_timeout_us == 0 || self.probe_timeout_us > self.reply_timeout_us {
+            return Err(ConfigError::ProbeTimeout);
+        }
+        if self.max_send_attempts == 0 {
+            return Err(ConfigError::NoSendAttempts);
+        }
+        Ok(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_is_valid() {
+        assert_eq!(
+            BasicConfig::default().validate(),
+            Ok(BasicConfig::default())
+        );
+    }
+
+    #[test]
+    fn a_timeout_at_or_past_the_clients_resend_is_refused() {
+        let config = BasicConfig {
+            reply_timeout_us: timing::HOST_REPLY_DEADLINE_US,
+            ..BasicConfig::default()
+        };
+        assert_eq!(config.validate(), Err(ConfigError::ReplyTimeout));
+        let config = BasicConfig {
+            max_send_attempts: 0,
+            ..BasicConfig::default()
+        };
+        assert_eq!(config.validate(), Err(ConfigError::NoSendAttempts));
     }
 }

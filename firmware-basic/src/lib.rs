@@ -26,7 +26,7 @@ pub mod status;
 mod supervisor;
 pub mod transparent;
 
-pub use config::{BasicConfig, EchoMode};
+pub use config::{BasicConfig, ConfigError, EchoMode};
 pub use io::{BasicIo, Buttons, NullIo};
 pub use status::{AtomLink, BasicError, BasicStatus, TransponderMode};
 
@@ -55,7 +55,8 @@ pub struct Basic {
 }
 
 impl Basic {
-    /// A transponder that has just been powered up.
+    /// A transponder that has just been powered up. `config` should have passed
+    /// [`BasicConfig::validate`]; an invalid one still never panics (0 send attempts act as 1).
     pub fn new(config: BasicConfig) -> Self {
         Self {
             config,

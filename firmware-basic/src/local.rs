@@ -4,7 +4,7 @@
 //! | code | reply |
 //! |---|---|
 //! | 0xA0 set output (pin 2 or 5, level 0/1) | `01` done, `00` refused (bad pin or level) |
-//! | 0xA1 get input (pin 35 or 36) | pin, level; level `FF` (pymycobot: -1) for a bad pin |
+//! | 0xA1 get input (pin 35 or 36) | pin, level; level `FF` (pymycobot: 255) for a bad pin |
 //! | 0xB0 set Wi-Fi SSID/password, 0xB2 set server port | `00`: the Basic has no Wi-Fi |
 //! | 0xB1 get Wi-Fi SSID/password | the text `ssid:  password: ` (pymycobot: `('', '')`) |
 //! | 0xC0 ToF distance | int16 mm; -1 without a sensor |
@@ -26,7 +26,8 @@ use crate::status::{BasicError, TransponderMode};
 /// What 0xB1 answers: no network configured, in the text form pymycobot parses.
 pub const NO_WIFI_TEXT: &[u8] = b"ssid:  password: ";
 
-/// Level byte of 0xA1 for a pin that cannot be read (pymycobot decodes it as -1).
+/// Level byte of 0xA1 for a pin that cannot be read: neither 0 nor 1 (pymycobot returns 255).
+/// A shorter reply would make pymycobot raise, no reply would cost it 1.5 s of retries.
 const NO_LEVEL: u8 = 0xFF;
 
 /// The Basic's answer to one of its own commands.
