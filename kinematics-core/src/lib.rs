@@ -15,6 +15,41 @@
 //! let q = kin.inverse(&pose, &JointAngles([0; 6])).unwrap();
 //! assert!(q.0.iter().all(|a| a.abs() <= 2));
 //! ```
+//!
+//! # What callers get
+//!
+//! * [`Kinematics::forward`]: the end pose (tool in world, per [`Kinematics::set_tool`] and
+//!   [`Kinematics::set_world`]) of joint angles, RPY as in `kinematics.md` (at ry = +-90 deg,
+//!   rz = 0).
+//! * [`Kinematics::inverse`]: all up to 8 closed-form branches, each joint wrapped by +-360 deg
+//!   into the [`JointLimits`], the best fit (exact, then up to 0.2 mm clamped, then traded at the
+//!   wrist singularity) nearest the seed; or an [`IkError`] (protocol error 32). The zero pose,
+//!   the stretched elbow and the wrist singularity (J6 keeps the seed's angle) all solve.
+//! * [`LinearPath`]: straight-line moves and Cartesian jogs, stopping with [`PathError`]
+//!   (33 / 34) instead of a joint jump or an unreachable step.
+//! * [`Transform`]-level variants (`forward_transform`, `inverse_transform`) for callers that
+//!   chain small Cartesian steps and should not round to the wire's units in between.
+//!
+//! # Accuracy and cost (measured)
+//!
+//! Against an f64 model of the DH table, 100 000 random in-limit joint vectors
+//! (`cargo test --release -p kinematics-core --test accuracy -- --nocapture`):
+//! * FK: worst 0.0005 mm and 0.0026 deg before rounding to the wire (0.085 mm / 0.011 deg after,
+//!   which is the wire's own rounding).
+//! * IK of the exact FK: 99.999 % within 0.1 mm / 0.05 deg, all cases farther than 1 deg from a
+//!   singularity; the one failure (0.12 mm) sits 0.16 deg from the combined shoulder and elbow
+//!   singularity, where the shoulder angle is ill-conditioned and the elbow is at full stretch.
+//! * IK of the FK rounded to the wire (what `get_coords` then `send_coords` does): 99.95 %;
+//!   the rest lie next to a singularity or a limit, where the rounding alone makes the pose
+//!   unreachable or moves its solution past the limit.
+//!
+//! Host cost (x86-64, release): FK about 0.5 us and 2 300 instructions, IK (all branches and the
+//! selection) about 2 us and 8 600 instructions per call:
+//! * `cargo bench -p kinematics-core` (criterion: FK, IK, a 27-step linear path);
+//! * `kinematics-core/benches/callgrind.sh` (instructions per call, via valgrind's callgrind:
+//!   the difference between runs of `examples/ik_count.rs` with N and with 0 calls);
+//! * `kinematics-core/benches/riscv_check.sh` builds for `riscv32imc-unknown-none-elf` (no FPU)
+//!   and checks the library references no floating-point routine and no panic.
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 

@@ -6,7 +6,7 @@ use crate::fixed::{Angle, ONE, atan2, mul, ratio, sqrt};
 
 /// Internal length unit: 1/16 micrometre, i.e. this many units per 0.1 mm. Fine enough that
 /// rounding never shows at the wire's 0.1 mm; coarse enough that a Q30 rotation times a
-/// position up to [`POSITION_LIMIT`] stays inside `i64`.
+/// position up to [`POSITION_LIMIT_TENTH_MM`] stays inside `i64`.
 pub const LEN_PER_TENTH_MM: i64 = 1600;
 
 /// Largest position coordinate accepted from a [`Pose`], in 0.1 mm (10 m, far beyond the wire's
