@@ -302,8 +302,21 @@ impl Forwarder {
         let collided = *collided;
         let silent = *echoed == 0;
         let grace_over = now_us.saturating_sub(done_at) >= ECHO_GRACE_US;
-        if collided || (grace_over && (echo_required || !silent)) {
+        let repeatable = self
+            .current
+            .as_ref()
+            .is_some_and(|flight| is_repeatable(&flight.request.frame));
+        if collided {
+            // The echo differed: the Atom heard the same garbled bytes.
             self.on_collision(now_us, config, on_event);
+        } else if grace_over && (echo_required || !silent) {
+            // The echo is missing or cut short: the frame may still have reached the Atom
+            // (bytes lost on our receive side). Send it again only if that is harmless.
+            if repeatable {
+                self.on_collision(now_us, config, on_event);
+            } else {
+                self.start_waiting(now_us, config);
+            }
         } else if silent && !echo_required {
             // An echo starts while the frame is still going out (byte 1 comes back while
             // byte 2 is sent): nothing back by now means this wiring does not echo, and what
@@ -378,10 +391,15 @@ impl Forwarder {
     }
 
     fn on_frame(&mut self, frame: Frame, on_event: &mut impl FnMut(Event)) {
+        // While waiting to send again, a reply to an earlier copy still answers the request.
         let answers = matches!(
             &self.current,
             Some(InFlight { request, stage: Stage::AwaitReply { .. }, .. })
                 if request.frame.cmd() == frame.cmd()
+        ) || matches!(
+            &self.current,
+            Some(InFlight { request, stage: Stage::WaitQuiet { .. }, attempts, .. })
+                if *attempts > 0 && request.frame.cmd() == frame.cmd()
         );
         if answers && let Some(done) = self.current.take() {
             on_event(Event::Reply {

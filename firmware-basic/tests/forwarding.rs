@@ -358,3 +358,18 @@ fn an_incremental_jog_is_never_sent_twice() {
     assert_eq!(rig.atom_got.len(), 1);
     assert!(rig.host.received().is_empty());
 }
+
+#[test]
+fn a_valid_reply_right_after_a_garbled_one_is_taken_without_asking_again() {
+    let mut rig = Rig::quiet(true);
+    rig.atom = Box::new(|f: &Frame| {
+        let mut bytes = frame(f.cmd(), &[1]);
+        bytes[2] ^= 0x5A;
+        bytes.extend(frame(f.cmd(), &[1]));
+        Some(bytes)
+    });
+    rig.host.send(&frame(IS_POWERED_ON, &[]));
+    rig.run_us(5_000);
+    assert_eq!(rig.atom_got.len(), 1);
+    assert_eq!(rig.host.received(), frame(IS_POWERED_ON, &[1]));
+}
