@@ -4,7 +4,9 @@
 //! A request is transmitted only into a quiet wire ([`timing::BUS_QUIET_BEFORE_SEND_US`]),
 //! its echo is read back and compared when the wiring echoes, a collision (echo differs, or a
 //! foreign byte while transmitting) is retransmitted after a growing back-off, at most
-//! [`BasicConfig::max_send_attempts`] times. Then only a complete `FE FE` frame with the
+//! [`BasicConfig::max_send_attempts`] times. An echo that is missing or cut short proves
+//! nothing (the frame may have gone out and only our receiver missed it), so it is
+//! retransmitted only if repeating the request is harmless. Then only a complete `FE FE` frame with the
 //! request's CMD byte counts as the reply; servo packets, other frames and late duplicates are
 //! dropped, and a request that gets no reply is given up after its deadline so the next one can
 //! go. Requests wait in a bounded queue meanwhile.

@@ -3,17 +3,29 @@
 //!
 //! The Basic makes the arm feel like one device: every host request reaches the Atom once,
 //! every reply reaches the host once, and nothing else leaks (servo packets, its own echo,
-//! replies to its internal requests). The board layer (esp-hal binary) binds [`BasicIo`] and
-//! two [`BytePort`]s and calls [`Basic::poll`] in a tight loop.
+//! replies to its internal requests). The board layer (esp-hal binary) and the virtual robot
+//! bind [`BasicIo`] and two [`BytePort`]s and call [`Basic::poll`] in a tight loop.
 //!
 //! * [`local`]: the commands the Basic answers itself (0xA0, 0xA1, 0xB0..0xB2, 0xC0..0xC3),
-//!   at once, even while the Atom is silent.
+//!   at once, even while the Atom is silent or a flood fills the queue. The Basic has no Wi-Fi:
+//!   0xB0/0xB2 are refused with `00`, 0xB1 reports empty credentials in the text form
+//!   pymycobot parses.
 //! * [`forwarder`]: everything else goes onto the bus, one request at a time, into a quiet
-//!   wire, echo checked, collisions retried; only the matching reply comes back.
-//! * [`transparent`]: raw bytes both ways after 0xC2 1, until `FE FE 03 C2 00 FA`.
+//!   wire, echo checked (heard or not: [`EchoMode::Auto`] finds out on the first send),
+//!   collisions and garbled replies retried; only the reply with the request's CMD comes back,
+//!   and a request the Atom does not answer is given up after
+//!   [`BasicConfig::reply_timeout_us`] (below pymycobot's 0.5 s resend).
+//! * [`transparent`]: after `0xC2 01` raw bytes go both ways (the Basic's echo removed),
+//!   until the host sends exactly `FE FE 03 C2 00 FA`; nothing else is interpreted then.
+//! * [`host_link`]: framing of the host stream (a frame cut by a 2 ms gap is dropped) and a
+//!   bounded output queue written only into an idle transmitter, so `poll` never blocks.
 //! * At boot the Basic powers the Atom on (0x10, like the vendor transponder) and afterwards
-//!   probes it (0x12) whenever it has been silent for a while; the replies to these internal
-//!   requests never reach the host. Button A powers the Atom on again.
+//!   probes it (0x12) whenever it has been silent for [`BasicConfig::probe_interval_us`]; the
+//!   replies to these internal requests never reach the host, they feed [`Basic::status`]
+//!   (what the LCD shows). Button A powers the Atom on again.
+//!
+//! Latency (bench `latency`, virtual time): the Basic adds one poll period to each direction
+//! on an idle wire, beyond the frame's own wire time.
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 

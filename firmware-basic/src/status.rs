@@ -63,7 +63,8 @@ pub struct BasicStatus {
     pub replies_forwarded: u32,
     /// Requests the Atom did not answer in time. Wraps.
     pub timeouts: u32,
-    /// Bus transmissions that collided (repeated or given up). Wraps.
+    /// Requests sent again (or given up) because they or their reply collided on the bus.
+    /// Wraps.
     pub collisions: u32,
     /// Host bytes dropped in transparent mode because the bus could not take them. Wraps.
     pub transparent_dropped: u32,
