@@ -8,7 +8,9 @@
 //!   and |s5| = the length of the other two components (wrist up/down); computing |s5| from
 //!   those components, not from sqrt(1 - c5^2), keeps t5 accurate next to the wrist singularity;
 //! * the last row of R16 is (s5 c6, -s5 s6, c5), which gives t6 unless s5 = 0 (J4 and J6
-//!   parallel: t6 is free and keeps its seed value);
+//!   parallel: t6 is free and keeps its seed value, unless that value moves the frame-4 origin,
+//!   which circles the wrist at radius d5 as t6 turns, out of the elbow's reach; then it turns
+//!   to the nearest value that reaches, see [`reachable_turn`]);
 //! * removing A1, A5 and A6 leaves a planar two-link chain a2, a3 in frame 1 whose end is the
 //!   origin of frame 4: the law of cosines gives t3 (elbow up/down), then t2, and t4 is what
 //!   remains of t2 + t3 + t4, read from the rotation.
@@ -31,12 +33,28 @@ const REACH_TOLERANCE: Len = 2 * LEN_PER_TENTH_MM;
 const EXACT_SLACK: Len = 2 * LEN_PER_TENTH_MM / 100;
 
 /// |sin t5| (Q30, 2.4e-4, i.e. q5 within 0.014 deg of +-90) below which the wrist is singular
-/// and t6 keeps its seed value. The orientation error this causes is at most |sin t5| times the
-/// change of t6 (0.044 deg if the seed is opposite, far less when it is the current angle), and
-/// it is what lets a pose read at the singularity and rounded to the wire's 0.01 deg (an
-/// orientation noise of 1e-4 rad, which would swing an exact t6 arbitrarily and move the frame-4
-/// origin on a d5-radius circle) be solved back to where it was read.
+/// and t6 is free (the seed's value). The orientation error this causes is at most |sin t5|
+/// times the change of t6 (0.044 deg if the seed is opposite, far less when it is the current
+/// angle). Above it, t6 follows from the orientation, which the wire's 0.01 deg rounding (up to
+/// 3e-4 rad) makes arbitrary near the singularity: see [`NEAR_SINGULAR_SIN`].
 const WRIST_SINGULAR_SIN: i64 = 1 << 18;
+
+/// |sin t5| (Q30, 2e-3, q5 within 0.11 deg of +-90) below which a t6 that leaves the target out
+/// of the elbow's reach is replaced by the seed's (then turned into reach), at an orientation
+/// error of at most |sin t5| times the change of t6. Wire rounding alone reaches 3e-4 here.
+const NEAR_SINGULAR_SIN: i64 = 1 << 21;
+
+/// Distance (0.05 mm) kept from the elbow's reach limits when t6 is chosen at the wrist
+/// singularity (covers the d6 * sin t5 the singular model neglects).
+const SINGULAR_REACH_MARGIN: Len = LEN_PER_TENTH_MM / 2;
+
+/// Right shift that brings the squared lengths of [`reachable_turn`] (up to 2^52) to a range
+/// whose squares fit `i64`.
+const TURN_SCALE_SHIFT: u32 = 24;
+
+/// How far (0.1 mm, the wire's rounding) a free t6 may leave the frame-4 origin beyond the
+/// elbow's reach and keep its value (the reach clamp absorbs that); farther, t6 is turned.
+const FREE_T6_SLACK: Len = LEN_PER_TENTH_MM;
 
 /// Wrist points farther than this (2 m) from the base axes are unreachable without further
 /// arithmetic (and keep every square inside `i64`).
@@ -68,19 +86,6 @@ pub(crate) struct Branch {
 
 /// Each branch that exists, indexed shoulder * 4 + wrist * 2 + elbow.
 pub(crate) type Branches = [Option<Branch>; MAX_BRANCHES];
-
-/// |sin t5| (Q30, 2e-3, q5 within 0.11 deg of +-90) below which a t6 that leaves the target out
-/// of the elbow's reach is replaced by the seed's (then turned into reach), at an orientation
-/// error of at most |sin t5| times the change of t6. Wire rounding alone reaches 3e-4 here.
-const NEAR_SINGULAR_SIN: i64 = 1 << 21;
-
-/// Distance (0.05 mm) kept from the elbow's reach limits when t6 is chosen at the wrist
-/// singularity (covers the d6 * sin t5 the singular model neglects).
-const SINGULAR_REACH_MARGIN: Len = LEN_PER_TENTH_MM / 2;
-
-/// Right shift that brings the squared lengths of [`reachable_turn`] (up to 2^52) to a range
-/// whose squares fit `i64`.
-const TURN_SCALE_SHIFT: u32 = 24;
 
 /// Frame 4 seen from frame 1, given M = A1^-1 * T06: (t2 + t3 + t4, origin x, origin y).
 /// T14 = M * A56^-1, of which only the rotation's first column and the position are needed:
@@ -185,20 +190,26 @@ pub(crate) fn solve(
             };
             let (mut t234, mut ex, mut ey) = frame4(links, &m, t5, t6);
             // Near the wrist singularity t6 moves the frame-4 origin on a d5 circle. If this t6
-            // puts it out of the elbow's reach by more than the wire's 0.1 mm (which the reach
-            // clamp absorbs), treat t6 as free: start from the seed's and turn to the nearest
-            // t6 that reaches. Inside the singular band that is exact; in the near band it is
-            // the fallback for poses whose rounding made them unreachable.
-            let slack = LEN_PER_TENTH_MM;
+            // puts it out of the elbow's reach by more than the wire's rounding, treat t6 as
+            // free: start from the seed's and turn to the nearest t6 that reaches. Inside the
+            // singular band that is exact; in the near band it is the fallback for poses whose
+            // rounding made them unreachable.
+            let reachable = |ex: Len, ey: Len| {
+                within(
+                    ex * ex + ey * ey,
+                    d_len - FREE_T6_SLACK,
+                    s_len + FREE_T6_SLACK,
+                )
+            };
             let mut approximate_wrist = false;
-            if s5 < NEAR_SINGULAR_SIN && !within(ex * ex + ey * ey, d_len - slack, s_len + slack) {
+            if s5 < NEAR_SINGULAR_SIN && !reachable(ex, ey) {
                 if !free_t6 {
                     t6 = seed_theta6;
                     approximate_wrist = true;
                     (t234, ex, ey) = frame4(links, &m, t5, t6);
                 }
                 let (lo, hi) = (d_len + SINGULAR_REACH_MARGIN, s_len - SINGULAR_REACH_MARGIN);
-                if !within(ex * ex + ey * ey, d_len - slack, s_len + slack)
+                if !reachable(ex, ey)
                     && let Some(turn) = reachable_turn(ex, ey, t234, d5, lo, hi)
                 {
                     // At t5 = 0, t234 + t6 is fixed; at t5 = 180 deg, t234 - t6 is.
@@ -210,6 +221,10 @@ pub(crate) fn solve(
             if !within(l2, d_len - REACH_TOLERANCE, s_len + REACH_TOLERANCE) {
                 continue;
             }
+            if l2 == 0 {
+                degenerate = true;
+                continue;
+            }
             let fit = if approximate_wrist {
                 Fit::NearSingular
             } else if shoulder_exact && within(l2, d_len - EXACT_SLACK, s_len + EXACT_SLACK) {
@@ -217,17 +232,14 @@ pub(crate) fn solve(
             } else {
                 Fit::Clamped
             };
-            if l2 == 0 {
-                degenerate = true;
-                continue;
-            }
             // cos t3 = (l2 - a2^2 - a3^2) / (2 a2 a3); sin t3 = sqrt((S^2 - l2)(l2 - D^2)) / (2 |a2 a3|).
             let sin3 = sqrt(s_len * s_len - l2) * sqrt(l2 - d_len * d_len);
             let cos3 = cos_sign * (l2 - a2 * a2 - a3 * a3);
+            let toward_e = atan2(ey, ex);
             for (elbow, sign3) in [1i64, -1].into_iter().enumerate() {
                 let t3 = atan2(sign3 * sin3, cos3);
                 let (s3, c3) = t3.sin_cos();
-                let t2 = atan2(ey, ex).sub(atan2(mul(a3, s3), a2 + mul(a3, c3)));
+                let t2 = toward_e.sub(atan2(mul(a3, s3), a2 + mul(a3, c3)));
                 let t4 = t234.sub(t2).sub(t3);
                 if let Some(slot) = out.get_mut(shoulder * 4 + wrist * 2 + elbow) {
                     *slot = Some(Branch {
