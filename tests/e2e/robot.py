@@ -30,13 +30,16 @@ ROT_TOL_DEG = 0.2
 MOVE_TIMEOUT = 6.0
 
 _arm = None
+# What the robot reported when this suite first connected: (is_power_on, get_angles).
+first_contact = None
 
 
 def arm():
     """The one shared MyCobot280 connection (opening costs 1.5 s in pymycobot)."""
-    global _arm
+    global _arm, first_contact
     if _arm is None:
         _arm = MyCobot280(PORT)
+        first_contact = (_arm.is_power_on(), _arm.get_angles())
     return _arm
 
 

@@ -40,6 +40,34 @@ class EncoderTest(RobotTestCase):
         self.home()
 
 
+    def test_set_encoders_drag_moves_the_joints(self):
+        self.home()
+        target = [2048 + 200, 2048, 2048 - 200, 2048, 2048, 2048 + 300]
+        self.assertEqual(self.mc.set_encoders_drag(target, [1000] * 6), 1)
+        arrived = wait_until(
+            lambda: all(abs(a - t) <= 3 for a, t in zip(self.mc.get_encoders(), target)) and self.mc.is_moving() == 0,
+            6.0,
+        )
+        self.assertTrue(arrived, f"encoders {self.mc.get_encoders()} vs {target}")
+        self.home()
+
+    def test_servo_calibration_makes_the_current_position_zero(self):
+        self.home()
+        self.assertEqual(self.mc.send_angle(6, 20, 100), 1)
+        self.assertTrue(wait_until(lambda: abs(self.mc.get_angles()[5] - 20) <= 0.2 and self.mc.is_moving() == 0, 4.0))
+        try:
+            self.assertEqual(self.mc.set_servo_calibration(6), 1)
+            self.assertAlmostEqual(self.mc.get_angles()[5], 0.0, delta=0.2, msg="not zero after calibration")
+            self.assertLessEqual(abs(self.mc.get_encoder(6) - 2048), 2)
+        finally:
+            # Undo: the old zero is now at -20 deg; calibrate there again.
+            self.mc.send_angle(6, -20, 100)
+            wait_until(lambda: abs(self.mc.get_angles()[5] + 20) <= 0.2 and self.mc.is_moving() == 0, 4.0)
+            self.mc.set_servo_calibration(6)
+        self.assertAlmostEqual(self.mc.get_angles()[5], 0.0, delta=0.3)
+        self.home()
+
+
 class LimitTest(RobotTestCase):
     def tearDown(self):
         for joint in range(1, 7):

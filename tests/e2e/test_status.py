@@ -2,10 +2,16 @@
 
 import unittest
 
+import robot
 from robot import RobotTestCase, wait_until
 
 
 class StatusTest(RobotTestCase):
+    def test_starts_powered_on_with_all_joints_at_zero(self):
+        powered, angles = robot.first_contact
+        self.assertEqual(powered, 1, "not powered on at start-up")
+        self.assertAnglesClose(angles, [0] * 6, msg="angles at start-up")
+
     def test_versions_are_reported(self):
         system = self.mc.get_system_version()
         self.assertIsInstance(system, float, f"get_system_version -> {system!r}")
