@@ -178,12 +178,15 @@ impl Kinematics {
     }
 
     /// The joint angles that put the end (per the selected frames) at `target`: of all branches
-    /// within the limits (each joint wrapped by +-360 deg), the one nearest `seed`.
+    /// within the limits (each joint wrapped by +-360 deg), the best fit (exact, then clamped to
+    /// reach by up to 0.2 mm, then traded at the wrist singularity), and of those the one nearest
+    /// `seed` (squared distance in joint space).
     pub fn inverse(&self, target: &Pose, seed: &JointAngles) -> Result<JointAngles, IkError> {
         self.inverse_transform(&Transform::from_pose(target), seed)
     }
 
-    /// [`Kinematics::inverse`] for a full-precision target transform.
+    /// [`Kinematics::inverse`] for a full-precision target transform (a rotation and a position
+    /// within the range [`Transform::from_pose`] produces).
     pub fn inverse_transform(
         &self,
         target: &Transform,

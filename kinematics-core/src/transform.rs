@@ -166,7 +166,9 @@ impl Rotation {
     }
 }
 
-/// A rigid transform: rotate, then translate by `position` ([`Len`] units).
+/// A rigid transform: rotate, then translate by `position` ([`Len`] units). Build it with
+/// [`Transform::from_pose`] or from this crate's results: arbitrary field values (a rotation that
+/// is not orthonormal, positions beyond a few [`POSITION_LIMIT_TENTH_MM`]) can overflow.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Transform {
     /// Orientation of the moving frame in the fixed frame.
