@@ -23,5 +23,5 @@ pub mod wire;
 pub use robot::{
     AskError, HostLink, POLL_PERIOD_NS, RobotConfig, SERVO_IDS, SimBasicIo, VirtualRobot,
 };
-pub use servo::{Faults, ServoStats, SimServo};
-pub use wire::{Bus, BusByte, SerialLine, StationId};
+pub use servo::{Faults, PacketListener, ServoStats, SimServo};
+pub use wire::{Bus, BusByte, HeardByte, SerialLine, StationId};

@@ -8,8 +8,8 @@ use protocol_core::timing::{HOST_BAUD, HOST_REPLY_DEADLINE_US};
 use protocol_core::units::{Centideg, Steps};
 use protocol_core::{Frame, FrameDecoder};
 
-use super::servo::SimServo;
-use super::wire::{Bus, SerialLine, SerialPort, StationId};
+use super::servo::{PacketListener, SimServo};
+use super::wire::{Bus, HeardByte, SerialLine, SerialPort, StationId};
 
 /// Longest virtual time between two polls of the Basic and the Atom, in ns: one byte time on
 /// the bus, so no station ever misses a byte-time boundary by more than that.
@@ -117,10 +117,10 @@ impl UsbLink {
     }
 
     fn next_event_ns(&self) -> Option<u64> {
-        [self.to_board.next_event_ns(), self.to_host.next_event_ns()]
-            .into_iter()
-            .flatten()
-            .min()
+        match (self.to_board.next_event_ns(), self.to_host.next_event_ns()) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
     }
 
     fn board_port(&mut self, now_ns: u64) -> SerialPort<'_> {
@@ -180,6 +180,9 @@ pub struct VirtualRobot {
     atom_usb: UsbLink,
     atom_io: RecordingIo,
     servos: Vec<SimulatedServo>,
+    /// One decoder for all servos: they hear the same bytes.
+    servo_listener: PacketListener,
+    heard: Vec<HeardByte>,
     noise_station: StationId,
     next_poll_ns: u64,
 }
@@ -199,11 +202,12 @@ impl VirtualRobot {
         let servos = SERVO_IDS
             .iter()
             .map(|&id| SimulatedServo {
-                station: bus.attach(false),
+                station: bus.attach_transmitter(),
                 servo: SimServo::new(id, config.initial_position_steps),
             })
             .collect();
         let noise_station = bus.attach(false);
+        bus.set_tap(true);
         Self {
             now_ns: 0,
             bus,
@@ -213,6 +217,8 @@ impl VirtualRobot {
             atom_usb: UsbLink::new(),
             atom_io: RecordingIo::default(),
             servos,
+            servo_listener: PacketListener::default(),
+            heard: Vec::new(),
             noise_station,
             next_poll_ns: 0,
         }
@@ -285,24 +291,27 @@ impl VirtualRobot {
     pub fn run_until(&mut self, t_us: u64) {
         let target = t_us.saturating_mul(1_000);
         while self.now_ns < target {
-            let next = [
-                Some(self.next_poll_ns),
-                self.bus.next_event_ns(),
-                self.atom_usb.next_event_ns(),
-                self.basic.as_ref().and_then(|b| b.usb.next_event_ns()),
-                self.servos
-                    .iter()
-                    .filter_map(|s| s.servo.next_event_ns())
-                    .min(),
-                Some(target),
-            ]
-            .into_iter()
-            .flatten()
-            .min()
-            .unwrap_or(target)
-            .max(self.now_ns + 1);
+            let next = self.next_event_ns(target).max(self.now_ns + 1);
             self.step(next);
         }
+    }
+
+    /// The next instant something happens (a poll is due, a byte ends, a servo answers), at
+    /// most `limit_ns`.
+    fn next_event_ns(&self, limit_ns: u64) -> u64 {
+        let mut next = self.next_poll_ns.min(limit_ns);
+        let mut consider = |t: Option<u64>| {
+            if let Some(t) = t {
+                next = next.min(t);
+            }
+        };
+        consider(self.bus.next_event_ns());
+        consider(self.atom_usb.next_event_ns());
+        consider(self.basic.as_ref().and_then(|b| b.usb.next_event_ns()));
+        for s in &self.servos {
+            consider(s.servo.next_event_ns());
+        }
+        next
     }
 
     /// Runs the robot for `dt_us` more microseconds of virtual time.
@@ -319,9 +328,20 @@ impl VirtualRobot {
         if let Some(basic) = self.basic.as_mut() {
             basic.usb.deliver(now_ns);
         }
+        self.bus.take_heard(&mut self.heard);
+        for heard in self.heard.drain(..) {
+            let servos = &mut self.servos;
+            self.servo_listener
+                .hear(heard.byte, heard.end_ns, |packet| {
+                    // A servo does not hear its own answers.
+                    for s in servos.iter_mut().filter(|s| s.station != heard.from) {
+                        s.servo.receive(&packet, heard.end_ns);
+                    }
+                });
+        }
         for s in &mut self.servos {
             if let Some(mut port) = self.bus.port(s.station) {
-                s.servo.poll(now_ns, &mut port);
+                s.servo.transmit_due(now_ns, &mut port);
             }
         }
         let now_us = now_ns / 1_000;

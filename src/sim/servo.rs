@@ -79,6 +79,34 @@ pub struct ServoStats {
     pub goal_writes: u64,
 }
 
+/// Finds servo packets in the bytes heard on the bus, dropping a partial packet when the line
+/// was quiet for [`PACKET_GAP_NS`] (a packet cut short must not swallow the next one).
+/// One listener can serve every servo on the bus: they all hear the same bytes.
+#[derive(Clone, Debug, Default)]
+pub struct PacketListener {
+    decoder: PacketDecoder,
+    last_byte_ns: u64,
+}
+
+impl PacketListener {
+    /// Takes one byte that arrived at `end_ns`; calls `on_packet` with each packet it completes.
+    pub fn hear(&mut self, byte: u8, end_ns: u64, mut on_packet: impl FnMut(Packet)) {
+        if end_ns.saturating_sub(self.last_byte_ns) >= PACKET_GAP_NS {
+            let mut cut = self.decoder.on_quiet_line();
+            while let Some(p) = cut {
+                on_packet(p);
+                cut = self.decoder.next_packet();
+            }
+        }
+        self.last_byte_ns = end_ns;
+        let mut found = self.decoder.push(byte);
+        while let Some(p) = found {
+            on_packet(p);
+            found = self.decoder.next_packet();
+        }
+    }
+}
+
 /// One simulated STS servo. See the [module doc](self).
 #[derive(Clone, Debug)]
 pub struct SimServo {
@@ -86,8 +114,8 @@ pub struct SimServo {
     raw_position_steps: f64,
     velocity_steps_per_s: f64,
     last_control_ns: u64,
-    decoder: PacketDecoder,
-    last_rx_ns: u64,
+    /// Decoder for [`SimServo::poll`] (standalone use).
+    listener: PacketListener,
     /// Status packets waiting for their start time (ns), in order.
     replies: VecDeque<(u64, Vec<u8>)>,
     registered: Option<(u8, Vec<u8>)>,
@@ -104,8 +132,7 @@ impl SimServo {
             raw_position_steps: f64::from(position.min(4095)),
             velocity_steps_per_s: 0.0,
             last_control_ns: 0,
-            decoder: PacketDecoder::new(),
-            last_rx_ns: 0,
+            listener: PacketListener::default(),
             replies: VecDeque::new(),
             registered: None,
             faults: Faults::default(),
@@ -201,6 +228,7 @@ impl SimServo {
         self.faults = faults;
         if faults.no_answer {
             self.replies.clear();
+            self.listener = PacketListener::default();
         }
         self.update_present_registers();
     }
@@ -226,35 +254,32 @@ impl SimServo {
         self.replies.front().map(|(t, _)| *t)
     }
 
-    /// Runs the servo up to `now_ns`: moves the shaft, takes the bytes it heard on `port`
-    /// (call this at every byte end, so each byte is heard at its own time), and queues on
-    /// `port` the replies due by now.
+    /// Runs the servo up to `now_ns` on its own: moves the shaft, decodes the bytes it heard on
+    /// `port` (call this at every byte end, so each byte is heard at its own time), obeys them,
+    /// and queues on `port` the replies due by now. [`crate::sim::VirtualRobot`] instead decodes
+    /// the bus once for all servos with a [`PacketListener`] and calls [`SimServo::receive`] and
+    /// [`SimServo::transmit_due`].
     pub fn poll(&mut self, now_ns: u64, port: &mut impl BytePort) {
-        self.advance(now_ns);
-        if self.faults.no_answer {
-            while port.read_byte().is_some() {}
-            self.decoder = PacketDecoder::new();
-            return;
-        }
-        let mut heard = false;
+        let mut listener = std::mem::take(&mut self.listener);
         while let Some(byte) = port.read_byte() {
-            if !heard && now_ns.saturating_sub(self.last_rx_ns) >= PACKET_GAP_NS {
-                let mut cut = self.decoder.on_quiet_line();
-                while let Some(p) = cut {
-                    self.obey(&p, now_ns);
-                    cut = self.decoder.next_packet();
-                }
-            }
-            heard = true;
-            let mut found = self.decoder.push(byte);
-            while let Some(p) = found {
-                self.obey(&p, now_ns);
-                found = self.decoder.next_packet();
-            }
+            listener.hear(byte, now_ns, |packet| self.receive(&packet, now_ns));
         }
-        if heard {
-            self.last_rx_ns = now_ns;
+        self.listener = listener;
+        self.transmit_due(now_ns, port);
+    }
+
+    /// Obeys `packet`, heard on the bus at `heard_ns` (when its last byte ended), if it is an
+    /// instruction for this servo. A servo with the `no_answer` fault hears nothing.
+    pub fn receive(&mut self, packet: &Packet, heard_ns: u64) {
+        self.advance(heard_ns);
+        if !self.faults.no_answer {
+            self.obey(packet, heard_ns);
         }
+    }
+
+    /// Moves the shaft up to `now_ns` and queues on `port` the replies due by then.
+    pub fn transmit_due(&mut self, now_ns: u64, port: &mut impl BytePort) {
+        self.advance(now_ns);
         while let Some((_, bytes)) = self.replies.pop_front_if(|(t, _)| *t <= now_ns) {
             port.write(&bytes);
         }
@@ -647,8 +672,7 @@ mod tests {
         let trace = rig.exchange(&Instruction::Ping.to_packet(1).unwrap());
         let request_end = trace
             .iter()
-            .filter(|b| b.from == rig.controller)
-            .last()
+            .rfind(|b| b.from == rig.controller)
             .unwrap()
             .end_ns;
         let answer_start = trace
@@ -674,8 +698,7 @@ mod tests {
         let trace = rig.exchange(&Instruction::Ping.to_packet(1).unwrap());
         let request_end = trace
             .iter()
-            .filter(|b| b.from == rig.controller)
-            .last()
+            .rfind(|b| b.from == rig.controller)
             .unwrap()
             .end_ns;
         let answer_start = trace

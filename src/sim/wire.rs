@@ -48,9 +48,22 @@ pub struct BusByte {
     pub garbled: bool,
 }
 
+/// A byte as a listener received it (garbled if it collided), with its sender.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HeardByte {
+    /// Who sent it.
+    pub from: StationId,
+    /// What listeners received.
+    pub byte: u8,
+    /// When it arrived (its stop bit ended), in ns.
+    pub end_ns: u64,
+}
+
 #[derive(Clone, Debug, Default)]
 struct Station {
     hears_echo: bool,
+    /// False for a station that only transmits and reads the bus through the tap.
+    receives: bool,
     tx: VecDeque<u8>,
     rx: VecDeque<u8>,
     /// End of the byte this station is sending now, if any.
@@ -66,6 +79,7 @@ pub struct Bus {
     in_flight: Vec<BusByte>,
     rng: u64,
     trace: Option<Vec<BusByte>>,
+    tap: Option<Vec<HeardByte>>,
     collisions: u64,
     last_end_ns: u64,
 }
@@ -80,6 +94,7 @@ impl Bus {
             // xorshift must not start at zero.
             rng: seed | 1,
             trace: None,
+            tap: None,
             collisions: 0,
             last_end_ns: 0,
         }
@@ -100,9 +115,31 @@ impl Bus {
     pub fn attach(&mut self, hears_echo: bool) -> StationId {
         self.stations.push(Station {
             hears_echo,
+            receives: true,
             ..Station::default()
         });
         StationId(self.stations.len() - 1)
+    }
+
+    /// Connects a station whose receiver is not modelled per station: it transmits through its
+    /// port, and what it hears is read once for all such stations from the [tap](Bus::take_heard)
+    /// (the simulated servos share one packet decoder this way).
+    pub fn attach_transmitter(&mut self) -> StationId {
+        self.stations.push(Station::default());
+        StationId(self.stations.len() - 1)
+    }
+
+    /// Starts (or stops) keeping every delivered byte, with its sender, for
+    /// [`Bus::take_heard`]. Off by default.
+    pub fn set_tap(&mut self, on: bool) {
+        self.tap = if on { Some(Vec::new()) } else { None };
+    }
+
+    /// Moves the bytes delivered since the last call into `out` (nothing unless the tap is on).
+    pub fn take_heard(&mut self, out: &mut Vec<HeardByte>) {
+        if let Some(tap) = self.tap.as_mut() {
+            out.append(tap);
+        }
     }
 
     /// The station's byte port (read what it received, queue what it sends).
@@ -144,19 +181,18 @@ impl Bus {
 
     /// The next instant the bus needs attention: the end of a byte on the wire.
     pub fn next_event_ns(&self) -> Option<u64> {
-        self.in_flight.iter().map(|b| b.end_ns).min()
+        let mut next = None;
+        for b in &self.in_flight {
+            if next.is_none_or(|t| b.end_ns < t) {
+                next = Some(b.end_ns);
+            }
+        }
+        next
     }
 
     /// Delivers every byte that has ended by `now_ns` to its listeners, in end order.
     pub fn deliver(&mut self, now_ns: u64) {
-        while let Some(i) = self
-            .in_flight
-            .iter()
-            .enumerate()
-            .filter(|(_, b)| b.end_ns <= now_ns)
-            .min_by_key(|(_, b)| b.end_ns)
-            .map(|(i, _)| i)
-        {
+        while let Some(i) = self.first_ended(now_ns) {
             let b = self.in_flight.swap_remove(i);
             let heard = if b.garbled {
                 b.byte ^ self.garble_mask()
@@ -170,6 +206,9 @@ impl Bus {
                         continue;
                     }
                 }
+                if !station.receives {
+                    continue;
+                }
                 if station.rx.len() < RX_BUFFER_BYTES {
                     station.rx.push_back(heard);
                 } else {
@@ -177,10 +216,28 @@ impl Bus {
                 }
             }
             self.last_end_ns = self.last_end_ns.max(b.end_ns);
+            if let Some(tap) = self.tap.as_mut() {
+                tap.push(HeardByte {
+                    from: b.from,
+                    byte: heard,
+                    end_ns: b.end_ns,
+                });
+            }
             if let Some(trace) = self.trace.as_mut() {
                 trace.push(b);
             }
         }
+    }
+
+    /// Index of the in-flight byte that ended first, if any ended by `now_ns`.
+    fn first_ended(&self, now_ns: u64) -> Option<usize> {
+        let mut first: Option<(usize, u64)> = None;
+        for (i, b) in self.in_flight.iter().enumerate() {
+            if b.end_ns <= now_ns && first.is_none_or(|(_, end)| b.end_ns < end) {
+                first = Some((i, b.end_ns));
+            }
+        }
+        first.map(|(i, _)| i)
     }
 
     /// Starts the next queued byte of every station whose transmitter is free at `now_ns`.
@@ -463,6 +520,25 @@ mod tests {
         );
         assert_eq!((trace[1].byte, trace[1].start_ns), (8, 10_100));
         assert!(trace.iter().all(|b| b.from == a && !b.garbled));
+    }
+
+    #[test]
+    fn the_tap_hears_everything_with_its_sender_and_transmitters_receive_nothing() {
+        let mut bus = Bus::mycobot(1);
+        let a = bus.attach(false);
+        let t = bus.attach_transmitter();
+        bus.set_tap(true);
+        bus.port(a).unwrap().write(&[1]);
+        run(&mut bus, 0, 10_000);
+        bus.port(t).unwrap().write(&[2]);
+        run(&mut bus, 10_000, 20_000);
+        let mut heard = Vec::new();
+        bus.take_heard(&mut heard);
+        let got: Vec<(StationId, u8, u64)> =
+            heard.iter().map(|h| (h.from, h.byte, h.end_ns)).collect();
+        assert_eq!(got, vec![(a, 1, 10_000), (t, 2, 20_000)]);
+        assert_eq!(bus.port(t).unwrap().rx_pending(), 0);
+        assert_eq!(read_all(&mut bus, a), vec![2]);
     }
 
     #[test]
