@@ -16,7 +16,8 @@
 //!   and a request the Atom does not answer is given up after
 //!   [`BasicConfig::reply_timeout_us`] (below pymycobot's 0.5 s resend).
 //! * [`transparent`]: after `0xC2 01` raw bytes go both ways (the Basic's echo removed),
-//!   until the host sends exactly `FE FE 03 C2 00 FA`; nothing else is interpreted then.
+//!   until the host sends exactly `FE FE 03 C2 00 FA`; only that and the exact mode frames
+//!   `FE FE 03 C2 01 FA` and `FE FE 02 C3 FA` are still answered by the Basic then.
 //! * [`host_link`]: framing of the host stream (a frame cut by a 2 ms gap is dropped) and a
 //!   bounded output queue written only into an idle transmitter, so `poll` never blocks.
 //! * At boot the Basic powers the Atom on (0x10, like the vendor transponder) and afterwards
@@ -47,7 +48,7 @@ use host_link::{HOST_READ_BUDGET, HostLink};
 use protocol_core::command::{Reply, cmd};
 use protocol_core::{BytePort, Frame};
 use supervisor::Supervisor;
-use transparent::Transparent;
+use transparent::{Intercepted, Transparent};
 
 /// Most bus bytes taken per poll: a poll stays short, and 256 bytes is 2.5 ms of bus time,
 /// far more than arrives between two polls of a board's loop.
@@ -193,8 +194,8 @@ impl Basic {
                     }
                 }
                 TransponderMode::Transparent => {
-                    if self.transparent.host_byte(byte) {
-                        self.leave_transparent();
+                    if let Some(hit) = self.transparent.host_byte(byte) {
+                        self.on_intercepted(hit);
                     }
                 }
             }
@@ -218,8 +219,8 @@ impl Basic {
             // A frame completed by the same byte as the one that entered transparent mode:
             // it is raw data now.
             for &b in frame.to_bytes().iter() {
-                if self.transparent.host_byte(b) {
-                    self.leave_transparent();
+                if let Some(hit) = self.transparent.host_byte(b) {
+                    self.on_intercepted(hit);
                 }
             }
             return;
@@ -258,12 +259,21 @@ impl Basic {
         self.transparent = Transparent::default();
     }
 
-    fn leave_transparent(&mut self) {
-        self.mode = TransponderMode::Framed;
-        self.host.reset_framer();
-        self.transparent = Transparent::default();
-        let ack = Reply::Ack.to_frame(cmd::SET_TRANSPONDER_MODE);
-        if !self.host.send_frame(&ack) {
+    /// Answers a frame the Basic still handles in transparent mode.
+    fn on_intercepted(&mut self, hit: Intercepted) {
+        let reply = match hit {
+            Intercepted::SetFramed => {
+                self.mode = TransponderMode::Framed;
+                self.host.reset_framer();
+                self.transparent = Transparent::default();
+                Reply::Ack.to_frame(cmd::SET_TRANSPONDER_MODE)
+            }
+            Intercepted::SetTransparent => Reply::Ack.to_frame(cmd::SET_TRANSPONDER_MODE),
+            Intercepted::GetMode => {
+                Reply::Byte(TransponderMode::Transparent as u8).to_frame(cmd::GET_TRANSPONDER_MODE)
+            }
+        };
+        if !self.host.send_frame(&reply) {
             self.supervisor.error(BasicError::HostOverflow);
         }
     }

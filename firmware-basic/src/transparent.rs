@@ -1,12 +1,14 @@
 //! Transparent mode (0xC2 1): raw bytes both ways between the host and the bus, for tools that
 //! talk to the servos directly.
 //!
-//! The one thing still recognised from the host is [`EXIT_FRAME`] (`FE FE 03 C2 00 FA`, "set
-//! transponder mode 0"): the Basic answers it with `FE FE 03 C2 01 FA` and returns to framed
-//! mode. Host bytes that might be the start of it are held back until they are known not to be
-//! (or the host goes quiet for [`timing::HOST_FRAME_GAP_US`]), so the exit frame never reaches
-//! the bus. Host bytes go onto the bus only into a quiet wire; the Basic's own echo is removed
-//! from what goes back to the host.
+//! Three exact frames from the host are still the Basic's own, so a client can always find out
+//! where it is and get back ([`Intercepted`]): `FE FE 03 C2 00 FA` (set mode 0: answered
+//! `01`, back to framed mode), `FE FE 03 C2 01 FA` (set mode 1: answered `01`) and
+//! `FE FE 02 C3 FA` (get mode: answered `01`). Host bytes that might be the start of one of
+//! them are held back until they are known not to be (or the host goes quiet for
+//! [`timing::HOST_FRAME_GAP_US`]), so these frames never reach the bus. Everything else is
+//! copied: host bytes go onto the bus only into a quiet wire, and every bus byte goes to the
+//! host except the Basic's own echo.
 
 use heapless::{Deque, Vec};
 use protocol_core::BytePort;
@@ -14,8 +16,36 @@ use protocol_core::timing;
 
 use crate::forwarder::ECHO_GRACE_US;
 
-/// The frame that ends transparent mode.
-pub const EXIT_FRAME: [u8; 6] = [0xFE, 0xFE, 0x03, 0xC2, 0x00, 0xFA];
+/// A host frame the Basic still answers in transparent mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Intercepted {
+    /// `FE FE 03 C2 00 FA`: back to framed mode.
+    SetFramed,
+    /// `FE FE 03 C2 01 FA`: stay transparent.
+    SetTransparent,
+    /// `FE FE 02 C3 FA`: which mode.
+    GetMode,
+}
+
+impl Intercepted {
+    /// Every intercepted frame with its wire bytes.
+    pub const ALL: [(Self, &'static [u8]); 3] = [
+        (Self::SetFramed, &[0xFE, 0xFE, 0x03, 0xC2, 0x00, 0xFA]),
+        (Self::SetTransparent, &[0xFE, 0xFE, 0x03, 0xC2, 0x01, 0xFA]),
+        (Self::GetMode, &[0xFE, 0xFE, 0x02, 0xC3, 0xFA]),
+    ];
+}
+
+/// Longest intercepted frame.
+const INTERCEPT_MAX: usize = 6;
+
+/// True if `held` could still become an intercepted frame.
+fn may_be_intercepted(held: &[u8]) -> bool {
+    Intercepted::ALL
+        .iter()
+        .any(|(_, bytes)| bytes.starts_with(held))
+}
+
 /// Host bytes waiting for the bus; the bus drains them 8x faster than the host fills them.
 pub const TO_BUS_CAPACITY: usize = 256;
 /// Most bytes written to the bus at once (and so most echo bytes expected back).
@@ -24,8 +54,8 @@ pub const BUS_WRITE_CHUNK: usize = 64;
 /// The transparent pipe's state.
 #[derive(Debug, Default)]
 pub(crate) struct Transparent {
-    /// Host bytes that match the start of [`EXIT_FRAME`] so far.
-    held: Vec<u8, 6>,
+    /// Host bytes that match the start of an intercepted frame so far.
+    held: Vec<u8, INTERCEPT_MAX>,
     to_bus: Deque<u8, TO_BUS_CAPACITY>,
     /// The last write to the bus while its echo may still come back...
     sent: Vec<u8, BUS_WRITE_CHUNK>,
@@ -38,27 +68,31 @@ pub(crate) struct Transparent {
 }
 
 impl Transparent {
-    /// Takes one byte from the host; true if it completed [`EXIT_FRAME`].
-    pub(crate) fn host_byte(&mut self, byte: u8) -> bool {
-        // Cannot fail: `held` is a strict prefix of the 6-byte exit frame, at most 5 bytes.
+    /// Takes one byte from the host; returns the intercepted frame it completes, if any.
+    pub(crate) fn host_byte(&mut self, byte: u8) -> Option<Intercepted> {
+        // Cannot fail: `held` is a strict prefix of an intercepted frame, shorter than
+        // INTERCEPT_MAX.
         let _ = self.held.push(byte);
-        if self.held.as_slice() == EXIT_FRAME {
+        if let Some((hit, _)) = Intercepted::ALL
+            .iter()
+            .find(|(_, bytes)| *bytes == self.held.as_slice())
+        {
             self.held.clear();
-            return true;
+            return Some(*hit);
         }
-        // Release bytes from the front until what is held could still become the exit frame.
-        while !EXIT_FRAME.starts_with(&self.held) {
+        // Release bytes from the front until what is held could still be intercepted.
+        while !may_be_intercepted(&self.held) {
             let first = self.held.first().copied();
             self.held.remove(0);
             if let Some(b) = first {
                 self.queue_for_bus(b);
             }
         }
-        false
+        None
     }
 
     /// Releases held-back bytes once the host has been quiet long enough that they cannot be
-    /// the start of an exit frame.
+    /// the start of an intercepted frame.
     pub(crate) fn host_quiet(&mut self, quiet_us: u64) {
         if quiet_us >= timing::HOST_FRAME_GAP_US && !self.held.is_empty() {
             let held = core::mem::take(&mut self.held);
@@ -157,33 +191,51 @@ mod tests {
         t.to_bus.iter().copied().collect()
     }
 
+    fn feed(t: &mut Transparent, bytes: &[u8]) -> std::vec::Vec<Intercepted> {
+        bytes.iter().filter_map(|&b| t.host_byte(b)).collect()
+    }
+
+    const EXIT: [u8; 6] = [0xFE, 0xFE, 0x03, 0xC2, 0x00, 0xFA];
+
     #[test]
     fn exit_frame_is_recognised_and_not_forwarded() {
         let mut t = Transparent::default();
         let ping = [0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB];
-        for b in ping {
-            assert!(!t.host_byte(b));
-        }
-        let exits: std::vec::Vec<bool> = EXIT_FRAME.iter().map(|&b| t.host_byte(b)).collect();
-        assert_eq!(exits, [false, false, false, false, false, true]);
+        assert!(feed(&mut t, &ping).is_empty());
+        let mut exit = EXIT.to_vec();
+        let last = exit.pop().unwrap();
+        assert!(feed(&mut t, &exit).is_empty());
+        assert_eq!(t.host_byte(last), Some(Intercepted::SetFramed));
         assert_eq!(drain(&mut t), ping);
+    }
+
+    #[test]
+    fn mode_query_and_set_transparent_are_answered_too() {
+        let mut t = Transparent::default();
+        let hits = feed(
+            &mut t,
+            &[
+                0xFE, 0xFE, 0x02, 0xC3, 0xFA, 0xFE, 0xFE, 0x03, 0xC2, 0x01, 0xFA,
+            ],
+        );
+        assert_eq!(hits, [Intercepted::GetMode, Intercepted::SetTransparent]);
+        assert!(drain(&mut t).is_empty());
     }
 
     #[test]
     fn a_near_miss_of_the_exit_frame_is_forwarded_whole_and_in_order() {
         let mut t = Transparent::default();
-        // FE FE FE 03 C2 01 FA: an extra FE, then "mode 1" - not an exit.
-        let bytes = [0xFE, 0xFE, 0xFE, 0x03, 0xC2, 0x01, 0xFA];
-        assert!(!bytes.iter().any(|&b| t.host_byte(b)));
+        // FE FE FE 03 C2 07 FA: an extra FE, then "mode 7" - not intercepted.
+        let bytes = [0xFE, 0xFE, 0xFE, 0x03, 0xC2, 0x07, 0xFA];
+        assert!(feed(&mut t, &bytes).is_empty());
         assert_eq!(drain(&mut t), bytes);
     }
 
     #[test]
     fn exit_frame_after_an_extra_header_byte_still_exits() {
         let mut t = Transparent::default();
-        assert!(!t.host_byte(0xFE));
-        let exits: std::vec::Vec<bool> = EXIT_FRAME.iter().map(|&b| t.host_byte(b)).collect();
-        assert_eq!(exits.last(), Some(&true));
+        assert_eq!(t.host_byte(0xFE), None);
+        assert_eq!(feed(&mut t, &EXIT), [Intercepted::SetFramed]);
         assert_eq!(drain(&mut t), [0xFE]);
     }
 

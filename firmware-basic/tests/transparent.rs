@@ -89,3 +89,21 @@ fn bus_bytes_faster_than_the_host_link_are_queued_not_lost() {
     rig.run_us(40_000);
     assert_eq!(rig.host.received(), burst);
 }
+
+#[test]
+fn the_mode_can_still_be_asked_and_set_in_transparent_mode() {
+    let mut rig = Rig::quiet(true);
+    enter(&mut rig);
+    rig.host.send(&frame(0xC3, &[]));
+    rig.run_us(2_000);
+    assert_eq!(rig.host.received(), frame(0xC3, &[1]));
+    rig.host.from_basic.clear();
+    rig.host.send(&frame(0xC2, &[1]));
+    rig.run_us(2_000);
+    assert_eq!(rig.host.received(), frame(0xC2, &[1]));
+    assert_eq!(rig.basic.status().mode, TransponderMode::Transparent);
+    assert!(
+        rig.wire().basic_sent.is_empty(),
+        "none of it reached the bus"
+    );
+}
