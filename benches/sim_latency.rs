@@ -129,6 +129,8 @@ fn main() {
     robot.bus_mut().set_tracing(true);
     send_motion(&mut robot, 60);
     robot.run_for(50_000);
+    let mut drain = Vec::new();
+    robot.host_read(&mut drain);
 
     let request = Request::GetAngles.to_frame();
     let request_wire_ns = wire_time_ns(request.encoded_len() as u32, HOST_BAUD);
@@ -170,7 +172,13 @@ fn main() {
                 host_first_byte_ns.push(first);
                 round_trips.push((robot.now_ns() - t_write) as f64 / 1_000.0);
             }
-            _ => lost += 1,
+            _ => {
+                lost += 1;
+                println!(
+                    "lost: request #{i} sent at {} us got no get_angles reply within 0.5 s",
+                    t_write / 1_000
+                );
+            }
         }
         trace.extend(robot.bus_mut().take_trace());
         // Ask again after 2..7 ms, like a client polling in a loop, sampling every phase of
@@ -250,7 +258,7 @@ fn main() {
         verdict(slowest >= REFRESH_TARGET_HZ)
     );
     println!(
-        "lost replies: {lost}, bus collisions: {}, wall time {:.2?}",
+        "lost replies: {lost}, bus bytes garbled by collisions: {}, wall time {:.2?}",
         robot.bus().collisions(),
         wall.elapsed()
     );
