@@ -91,6 +91,21 @@ impl HostLink {
         true
     }
 
+    /// Queues one raw byte (transparent mode), dropping the oldest queued byte if the queue is
+    /// full: a raw tool needs the newest traffic (its servo's answer), not the stale backlog.
+    /// False if a byte was dropped.
+    pub(crate) fn send_raw(&mut self, byte: u8) -> bool {
+        let dropped = self.tx.is_full() && self.tx.pop_front().is_some();
+        // Cannot fail: there is room now.
+        let _ = self.tx.push_back(byte);
+        !dropped
+    }
+
+    /// Forgets every byte not yet handed to the host port.
+    pub(crate) fn clear_tx(&mut self) {
+        self.tx.clear();
+    }
+
     /// Hands queued bytes to the host port once its transmitter is idle.
     pub(crate) fn flush<H: BytePort>(&mut self, host: &mut H) {
         if self.tx.is_empty() || !host.tx_idle() {

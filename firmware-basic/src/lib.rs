@@ -259,8 +259,10 @@ impl Basic {
         self.transparent = Transparent::default();
     }
 
-    /// Answers a frame the Basic still handles in transparent mode.
+    /// Answers a frame the Basic still handles in transparent mode. Raw traffic still queued
+    /// for the host is dropped so the answer is not lost behind a backlog of bus bytes.
     fn on_intercepted(&mut self, hit: Intercepted) {
+        self.host.clear_tx();
         let reply = match hit {
             Intercepted::SetFramed => {
                 self.mode = TransponderMode::Framed;
@@ -281,7 +283,7 @@ impl Basic {
 
 /// Queues one raw byte for the host, noting an overflow.
 fn send_raw(host: &mut HostLink, supervisor: &mut Supervisor, byte: u8) {
-    if !host.send_bytes(&[byte]) {
+    if !host.send_raw(byte) {
         supervisor.error(BasicError::HostOverflow);
     }
 }

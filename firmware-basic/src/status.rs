@@ -37,7 +37,8 @@ pub enum BasicError {
         /// The pin number asked for.
         pin: u8,
     },
-    /// Bytes for the host were dropped because the host link could not keep up.
+    /// Bytes for the host were dropped because the host link could not keep up (in
+    /// transparent mode a busy bus outpaces the 115200 host link; the oldest bytes go).
     HostOverflow,
 }
 

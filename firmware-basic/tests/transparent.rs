@@ -107,3 +107,31 @@ fn the_mode_can_still_be_asked_and_set_in_transparent_mode() {
         "none of it reached the bus"
     );
 }
+
+#[test]
+fn on_a_busy_bus_the_host_gets_the_newest_bytes_and_the_mode_answer() {
+    let mut rig = Rig::quiet(false);
+    enter(&mut rig);
+    // 2000 bytes of servo traffic in 20 ms: far more than 115200 baud carries.
+    let flood: Vec<u8> = (0..2_000u32).map(|i| (i % 200) as u8).collect();
+    let now = rig.now_ns;
+    rig.wire().inject(now + 10_000, &flood);
+    rig.run_us(25_000);
+    let now = rig.now_ns;
+    rig.wire().inject(now + 10_000, &PING_REPLY);
+    rig.run_us(60_000);
+    let got = rig.host.received();
+    assert!(got.ends_with(&PING_REPLY), "the newest bytes arrive");
+    assert!(got.len() < 1_000, "the backlog was cut");
+    // The mode answer is not lost behind a backlog.
+    let now = rig.now_ns;
+    rig.wire().inject(now + 10_000, &flood);
+    rig.run_us(5_000);
+    rig.host.from_basic.clear();
+    rig.host.send(&frame(0xC3, &[]));
+    // At most the one 64-byte chunk already handed to the port (5.6 ms) comes first.
+    rig.run_us(8_000);
+    let got = rig.host.received();
+    let answer = frame(0xC3, &[1]);
+    assert!(got.windows(answer.len()).any(|w| w == answer), "{got:02x?}");
+}
