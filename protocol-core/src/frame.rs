@@ -177,11 +177,14 @@ impl FrameDecoder {
             };
             let (chunk, rest) = bytes.split_at(take.min(bytes.len()));
             bytes = rest;
-            for &b in chunk {
-                if self.buf.is_full() {
-                    self.drop_front(1);
+            // `take` fits the buffer unless a caller left frames undrained: then evict.
+            if self.buf.extend_from_slice(chunk).is_err() {
+                for &b in chunk {
+                    if self.buf.is_full() {
+                        self.drop_front(1);
+                    }
+                    let _ = self.buf.push(b);
                 }
-                let _ = self.buf.push(b);
             }
             while let Some(frame) = self.next_frame() {
                 on_frame(frame);

@@ -534,11 +534,14 @@ impl PacketDecoder {
             };
             let (chunk, rest) = bytes.split_at(take.min(bytes.len()));
             bytes = rest;
-            for &b in chunk {
-                if self.buf.is_full() {
-                    self.drop_front(1);
+            // `take` fits the buffer unless a caller left frames undrained: then evict.
+            if self.buf.extend_from_slice(chunk).is_err() {
+                for &b in chunk {
+                    if self.buf.is_full() {
+                        self.drop_front(1);
+                    }
+                    let _ = self.buf.push(b);
                 }
-                let _ = self.buf.push(b);
             }
             while let Some(packet) = self.next_packet() {
                 on_packet(packet);
