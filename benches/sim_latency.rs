@@ -27,6 +27,8 @@ const REFRESH_TARGET_HZ: f64 = 100.0;
 /// A host frame one station sent, with the times of its first and last byte on the bus.
 struct SentFrame {
     cmd: u8,
+    /// Whether another transmission overlapped any of its bytes.
+    garbled: bool,
     first_start_ns: u64,
     last_end_ns: u64,
 }
@@ -42,6 +44,9 @@ fn frames_from(trace: &[BusByte], station: StationId) -> Vec<SentFrame> {
             let first = i + 1 - frame.encoded_len().min(i + 1);
             out.push(SentFrame {
                 cmd: frame.cmd(),
+                garbled: bytes
+                    .get(first..=i)
+                    .is_some_and(|f| f.iter().any(|b| b.garbled)),
                 first_start_ns: bytes[first].start_ns,
                 last_end_ns: b.end_ns,
             });
@@ -256,6 +261,14 @@ fn main() {
     println!(
         "  target >= {REFRESH_TARGET_HZ} Hz on every joint: {}",
         verdict(slowest >= REFRESH_TARGET_HZ)
+    );
+    let forwarded = basic_frames.len();
+    let hit = basic_frames.iter().filter(|f| f.garbled).count();
+    let replies_hit = atom_frames.iter().filter(|f| f.garbled).count();
+    println!(
+        "frames hit by a collision: {hit} of {forwarded} sent by the Basic, {replies_hit} of {} \
+         sent by the Atom",
+        atom_frames.len()
     );
     println!(
         "lost replies: {lost}, bus bytes garbled by collisions: {}, wall time {:.2?}",
