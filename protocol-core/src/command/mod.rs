@@ -286,6 +286,10 @@ mod tests {
 
     #[test]
     fn every_known_code_is_known_and_others_are_not() {
+        assert!(
+            cmd::ALL.windows(2).all(|w| w[0] < w[1]),
+            "ALL must be ascending"
+        );
         let known = (0..=255u8).filter(|&c| cmd::is_known(c)).count();
         assert_eq!(known, cmd::ALL.len());
         assert!(!cmd::is_known(0x00) && !cmd::is_known(0xFE));
