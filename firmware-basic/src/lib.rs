@@ -25,6 +25,12 @@
 //!   replies to these internal requests never reach the host, they feed [`Basic::status`]
 //!   (what the LCD shows). Button A powers the Atom on again.
 //!
+//! How the ports are used, for whoever implements them: the Basic reads with
+//! [`BytePort::read_byte`] until it returns `None` (at most [`BUS_READ_BUDGET`] bus and
+//! [`host_link::HOST_READ_BUDGET`] host bytes per poll), and writes only into an idle
+//! transmitter ([`BytePort::tx_idle`]), at most 67 bytes to the bus and 64 to the host at a
+//! time, so a write never waits on a 128-byte UART FIFO. Timing comes only from `now_us`.
+//!
 //! Latency (bench `latency`, virtual time): the Basic adds one poll period to each direction
 //! on an idle wire, beyond the frame's own wire time.
 #![cfg_attr(not(test), no_std)]
