@@ -167,7 +167,7 @@ pub enum HostLink {
     AtomUsb,
 }
 
-/// The virtual myCobot 280 M5. See the [module doc](self).
+/// The virtual myCobot 280 M5. See the [simulation overview](crate::sim).
 ///
 /// Time only moves in [`VirtualRobot::run_until`] / [`VirtualRobot::run_for`], as fast as the
 /// host computes it. A real-time driver calls `run_until(wall_clock_us)` in a loop.
