@@ -56,6 +56,15 @@ const TURN_SCALE_SHIFT: u32 = 24;
 /// elbow's reach and keep its value (the reach clamp absorbs that); farther, t6 is turned.
 const FREE_T6_SLACK: Len = LEN_PER_TENTH_MM;
 
+/// How far (0.03 mm) the wrist point may move sideways to let t1 stay near the seed's next to
+/// the shoulder singularity, where the wire's rounding would otherwise swing t1 (and t5) by a
+/// degree or more for the same pose.
+const SHOULDER_SLACK: Len = 3 * LEN_PER_TENTH_MM / 10;
+
+/// Largest distance of the seed's shoulder angle from the nominal one that
+/// [`SHOULDER_SLACK`] can absorb (it allows under 2 deg).
+const SHOULDER_SEED_WINDOW: Angle = Angle::from_centideg(300);
+
 /// Wrist points farther than this (2 m) from the base axes are unreachable without further
 /// arithmetic (and keep every square inside `i64`).
 const MAX_WRIST_COORD: Len = 20_000 * LEN_PER_TENTH_MM;
@@ -141,13 +150,15 @@ fn within(v: i64, low: Len, high: Len) -> bool {
     v >= low * low && v <= high * high
 }
 
-/// All IK branches for the flange pose `target` (base frame). `seed_theta6` is used for t6 at
-/// the wrist singularity.
+/// All IK branches for the flange pose `target` (base frame). The seed's DH angles `seed_theta`
+/// settle what the pose leaves open or ill-conditioned: t1 next to the shoulder singularity and
+/// t6 at the wrist singularity.
 pub(crate) fn solve(
     links: &Links,
     target: &Transform,
-    seed_theta6: Angle,
+    seed_theta: &[Angle; 6],
 ) -> Result<Branches, IkError> {
+    let [seed_theta1, _, _, _, _, seed_theta6] = *seed_theta;
     let [_, _, _, d4, d5, d6] = links.d;
     let [_, a2, a3, _, _, _] = links.a;
     let r = &target.rotation;
@@ -164,13 +175,32 @@ pub(crate) fn solve(
     }
     let shoulder_exact = within(r2, d4 - EXACT_SLACK, 2 * MAX_WRIST_COORD);
     let psi = atan2(wy, wx);
-    let phi = atan2(sqrt(r2 - d4 * d4), d4);
+    // t1 = psi + 90 deg +- phi with tan(phi) = h / d4, h^2 = r^2 - d4^2. Next to the shoulder
+    // singularity (h -> 0) a wrist-point error e changes h^2 by 2 r e, which swings phi widely
+    // while the pose hardly changes: keep the seed's phi if a wrist point within SHOULDER_SLACK
+    // of the target's allows it.
+    let h2 = r2 - d4 * d4;
+    let h2_slack = 2 * sqrt(r2) * SHOULDER_SLACK;
+    let phi = atan2(sqrt(h2), d4);
+    let seed_phi = seed_theta1.sub(psi).sub(Angle::QUARTER);
+    let keep_seed = |seed_side: Angle| {
+        // The slack allows a few degrees at most: skip the bounds for seeds farther off.
+        seed_side.sub(phi).0.unsigned_abs() < SHOULDER_SEED_WINDOW.0.unsigned_abs()
+            && (atan2(sqrt(h2 - h2_slack), d4).0..=atan2(sqrt(h2 + h2_slack), d4).0)
+                .contains(&seed_side.0)
+    };
 
     let (s_len, d_len) = (a2.abs() + a3.abs(), (a2.abs() - a3.abs()).abs());
     let cos_sign = if (a2 < 0) == (a3 < 0) { 1 } else { -1 };
     let mut out: Branches = [None; MAX_BRANCHES];
     let mut degenerate = false;
-    for (shoulder, t1) in [psi.add(phi), psi.sub(phi)].into_iter().enumerate() {
+    for (shoulder, seed_side) in [seed_phi, seed_phi.neg()].into_iter().enumerate() {
+        let phi = if keep_seed(seed_side) { seed_side } else { phi };
+        let t1 = if shoulder == 0 {
+            psi.add(phi)
+        } else {
+            psi.sub(phi)
+        };
         let t1 = t1.add(Angle::QUARTER);
         let (s1, c1) = t1.sin_cos();
         let c5 = mul(z[0], s1) - mul(z[1], c1);

@@ -34,17 +34,16 @@
 //!
 //! Against an f64 model of the DH table, 100 000 random in-limit joint vectors
 //! (`cargo test --release -p kinematics-core --test accuracy -- --nocapture`):
-//! * FK: worst 0.0005 mm and 0.0026 deg before rounding to the wire (0.085 mm / 0.011 deg after,
-//!   which is the wire's own rounding).
-//! * IK of the exact FK: 99.999 % within 0.1 mm / 0.05 deg, all cases farther than 1 deg from a
-//!   singularity; the one failure (0.12 mm) sits 0.16 deg from the combined shoulder and elbow
-//!   singularity, where the shoulder angle is ill-conditioned and the elbow is at full stretch.
-//! * IK of the FK rounded to the wire (what `get_coords` then `send_coords` does): 99.95 %;
+//! * FK: worst 0.0005 mm and 0.000001 deg before rounding to the wire (0.085 mm / 0.011 deg
+//!   after, which is the wire's own rounding).
+//! * IK of the exact FK, answers rounded to 0.01 deg: 100 % within 0.1 mm / 0.05 deg (worst
+//!   0.048 mm, 0.022 deg), singular configurations included.
+//! * IK of the FK rounded to the wire (what `get_coords` then `send_coords` does): 99.96 %;
 //!   the rest lie next to a singularity or a limit, where the rounding alone makes the pose
 //!   unreachable or moves its solution past the limit.
 //!
 //! Host cost (x86-64, release): FK about 0.5 us and 2 300 instructions, IK (all branches and the
-//! selection) about 2 us and 8 600 instructions per call:
+//! selection) about 2 us and 8 500 instructions per call:
 //! * `cargo bench -p kinematics-core` (criterion: FK, IK, a 27-step linear path);
 //! * `kinematics-core/benches/callgrind.sh` (instructions per call, via valgrind's callgrind:
 //!   the difference between runs of `examples/ik_count.rs` with N and with 0 calls);
@@ -192,8 +191,7 @@ impl Kinematics {
         target: &Transform,
         seed: &JointAngles,
     ) -> Result<JointAngles, IkError> {
-        let seed_theta6 = self.links.theta(5, seed.0[5]);
-        let branches = ik::solve(&self.links, &self.flange_of(target), seed_theta6)?;
+        let branches = ik::solve(&self.links, &self.flange_of(target), &self.seed_theta(seed))?;
         // The best fit first (exact, clamped, near-singular), then the nearest to the seed.
         branches
             .iter()
@@ -223,17 +221,18 @@ impl Kinematics {
         target: &Transform,
         seed: &JointAngles,
     ) -> Result<[Option<JointAngles>; 8], IkError> {
-        let branches = ik::solve(
-            &self.links,
-            &self.flange_of(target),
-            self.links.theta(5, seed.0[5]),
-        )?;
+        let branches = ik::solve(&self.links, &self.flange_of(target), &self.seed_theta(seed))?;
         let best = branches.iter().flatten().map(|b| b.fit).min();
         Ok(branches.map(|b| {
             b.filter(|b| Some(b.fit) == best)
                 .and_then(|b| self.in_limits_near(&b.theta, seed))
                 .map(|(q, _)| q)
         }))
+    }
+
+    /// The DH angles of the seed.
+    fn seed_theta(&self, seed: &JointAngles) -> [Angle; 6] {
+        core::array::from_fn(|i| self.links.theta(i, seed.0.get(i).copied().unwrap_or(0)))
     }
 
     /// The flange pose (base frame) that puts the end at `target` (selected frames).

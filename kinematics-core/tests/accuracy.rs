@@ -101,11 +101,14 @@ fn distance(a: &Mat, b: &Mat) -> (f64, f64) {
         .map(|i| (a[i][3] - b[i][3]).powi(2))
         .sum::<f64>()
         .sqrt();
-    // Angle of a^T b from its trace.
-    let trace: f64 = (0..3)
-        .map(|i| (0..3).map(|k| a[k][i] * b[k][i]).sum::<f64>())
-        .sum();
-    let angle = ((trace - 1.0) / 2.0).clamp(-1.0, 1.0).acos().to_degrees();
+    // For rotations |Ra - Rb| (Frobenius) = 2 sqrt(2) sin(angle / 2); unlike acos of the trace
+    // this stays linear in small errors.
+    let frobenius = (0..3)
+        .flat_map(|r| (0..3).map(move |c| (r, c)))
+        .map(|(r, c)| (a[r][c] - b[r][c]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let angle = (2.0 * (frobenius / (2.0 * 2f64.sqrt())).min(1.0).asin()).to_degrees();
     (dp, angle)
 }
 
@@ -482,4 +485,32 @@ fn tool_and_world_frames_apply_both_ways() {
     kin.set_tool(None);
     kin.set_world(None);
     assert_eq!(kin.forward(&JointAngles::default()).z, 4127);
+}
+
+/// A user reads the coordinates and sends them back: the arm must not move, also at the
+/// singular configurations users start from (the arm upright, any base angle).
+#[test]
+fn resending_the_read_coordinates_keeps_the_joints() {
+    let kin = Kinematics::new();
+    for q in [
+        [0, 0, 0, 0, 0, 0],
+        [1234, 0, 0, 0, 0, 0],
+        [-4500, 0, 0, 0, 0, 0],
+        [3000, 0, 0, 0, 0, 3000],
+        [0, 0, 0, 0, 9000, 0],
+        [2000, 0, 0, 0, -9000, 4500],
+        [0, -3000, -3000, 0, 0, 0],
+        [9000, -4500, -9000, 4500, 0, 0],
+        [-2500, 3000, -6000, 3000, 0, 0],
+    ] {
+        let q = JointAngles(q);
+        let sol = kin.inverse(&kin.forward(&q), &q).unwrap();
+        assert!(
+            sol.0
+                .iter()
+                .zip(q.0.iter())
+                .all(|(a, b)| (a - b).abs() <= 5),
+            "{q:?} -> {sol:?}"
+        );
+    }
 }
