@@ -215,3 +215,22 @@ fn every_request_gets_exactly_one_reply_and_never_its_echo() {
         assert_silent_for(&mut robot, HostLink::Basic, 100_000);
     }
 }
+
+#[test]
+fn requests_sent_back_to_back_are_answered_in_order() {
+    let mut robot = arm();
+    let mut bytes = Vec::new();
+    for request in [Request::GetAngles, Request::IsPowerOn, Request::GetEncoders] {
+        bytes.extend_from_slice(&request.to_frame().to_bytes());
+    }
+    robot.host_write(&bytes);
+    robot.run_for(100_000);
+    let mut answer = Vec::new();
+    robot.host_read(&mut answer);
+    let mut cmds = Vec::new();
+    protocol_core::FrameDecoder::new().feed(&answer, |f| cmds.push(f.cmd()));
+    assert_eq!(
+        cmds,
+        vec![cmd::GET_ANGLES, cmd::IS_POWER_ON, cmd::GET_ENCODERS]
+    );
+}

@@ -552,6 +552,22 @@ mod tests {
     }
 
     #[test]
+    fn the_same_inputs_give_the_same_bus_traffic() {
+        let session = || {
+            let mut robot = VirtualRobot::new(RobotConfig::default());
+            robot.bus_mut().set_tracing(true);
+            robot.run_for(30_000);
+            robot.host_write(&Request::GetAngles.to_frame().to_bytes());
+            robot.inject_bus_noise(&[0x12, 0x34]);
+            robot.run_for(30_000);
+            robot.bus_mut().take_trace()
+        };
+        let first = session();
+        assert!(!first.is_empty());
+        assert_eq!(first, session());
+    }
+
+    #[test]
     fn measured_angles_follow_the_shafts() {
         let mut robot = VirtualRobot::new(RobotConfig::default());
         robot
