@@ -26,12 +26,19 @@ fn main() -> ExitCode {
 fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
     // Signals first: a Ctrl-C during start-up must still remove the symlink.
     let stop = stop_on_signals()?;
-    let pty = PseudoTerminal::open()?;
-    let tcp = cli.tcp.map(TcpServer::bind).transpose()?;
+    let pty =
+        PseudoTerminal::open().map_err(|e| format!("cannot create a pseudo-terminal: {e}"))?;
+    let tcp = cli
+        .tcp
+        .map(|addr| TcpServer::bind(addr).map_err(|e| format!("cannot listen on {addr}: {e}")))
+        .transpose()?;
     let link = cli
         .pty_link
         .as_deref()
-        .map(|path| PtyLink::create(path, pty.slave_path()))
+        .map(|path| {
+            PtyLink::create(path, pty.slave_path())
+                .map_err(|e| format!("cannot create the link {}: {e}", path.display()))
+        })
         .transpose()?;
 
     let mut out = std::io::stdout().lock();
