@@ -84,3 +84,67 @@ fn the_basic_answers_its_own_pins() {
         Reply::Byte(v) if v > 0
     ));
 }
+
+#[test]
+fn half_a_frame_and_garbage_from_the_host_do_not_block_the_next_request() {
+    let mut robot = arm();
+    let full = Request::GetAngles.to_frame().to_bytes();
+    // A client killed mid-write, then line noise, then a fresh client.
+    robot.host_write(&full[..3]);
+    robot.run_for(20_000);
+    robot.host_write(&[0x00, 0xFA, 0x13, 0xFE]);
+    robot.run_for(20_000);
+    let reply = ask(&mut robot, Request::IsPowerOn);
+    assert_eq!(reply, Reply::Byte(1));
+    assert_silent_for(&mut robot, HostLink::Basic, 100_000);
+}
+
+#[test]
+fn transparent_mode_lets_the_host_talk_to_a_servo() {
+    use protocol_core::command::TransponderMode;
+    use protocol_core::servo::{Instruction, PacketDecoder, reg};
+    let mut robot = arm();
+    ack(
+        &mut robot,
+        Request::SetTransponderMode {
+            mode: TransponderMode::Transparent,
+        },
+    );
+    let read_id = Instruction::Read {
+        addr: reg::ID,
+        count: 1,
+    }
+    .to_packet(3)
+    .expect("packet");
+    let mut answers = Vec::new();
+    // The Atom keeps using the bus: a request may collide, so try a few times like a tool would.
+    for _ in 0..5 {
+        robot.host_write(&read_id.to_bytes());
+        robot.run_for(20_000);
+        let mut bytes = Vec::new();
+        robot.host_read(&mut bytes);
+        PacketDecoder::new().feed(&bytes, |p| {
+            if p.id() == 3 && p.params() == [3] {
+                answers.push(p);
+            }
+        });
+        if !answers.is_empty() {
+            break;
+        }
+    }
+    assert!(
+        !answers.is_empty(),
+        "servo 3 never answered through the Basic"
+    );
+    robot.host_write(
+        &Request::SetTransponderMode {
+            mode: TransponderMode::Framed,
+        }
+        .to_frame()
+        .to_bytes(),
+    );
+    robot.run_for(50_000);
+    let mut drain = Vec::new();
+    robot.host_read(&mut drain);
+    assert_eq!(ask(&mut robot, Request::IsPowerOn), Reply::Byte(1));
+}
