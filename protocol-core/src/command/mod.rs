@@ -8,6 +8,29 @@
 //!   a test) with [`Reply::parse`] given the [`ReplyKind`] its request expects.
 //! * [`CommandError`], [`ErrorCode`], [`ServoErrorCode`]: what went wrong, on the wire.
 //! * [`is_basic_local`]: which commands the Basic answers itself instead of forwarding.
+//!
+//! A firmware's receive path, in short:
+//!
+//! ```
+//! use protocol_core::command::{JointId, Reply, Request};
+//! use protocol_core::units::Centideg;
+//! use protocol_core::FrameDecoder;
+//!
+//! // pymycobot's send_angle(2, -0.02, 50): the angle -2 is FF FE inside the data.
+//! let wire = [0xFE, 0xFE, 0x06, 0x21, 0x02, 0xFF, 0xFE, 0x32, 0xFA];
+//! let mut replies = Vec::new();
+//! FrameDecoder::new().feed(&wire, |frame| {
+//!     let reply = match Request::parse(&frame) {
+//!         Ok(Request::SendAngle { joint, angle, .. }) => {
+//!             assert_eq!((joint, angle), (JointId::new(2).unwrap(), Centideg(-2)));
+//!             Reply::Ack
+//!         }
+//!         Ok(_) | Err(_) => Reply::Byte(0),
+//!     };
+//!     replies.push(reply.to_frame(frame.cmd()).to_bytes());
+//! });
+//! assert_eq!(replies[0].as_slice(), &[0xFE, 0xFE, 0x03, 0x21, 0x01, 0xFA]);
+//! ```
 
 mod error;
 mod reply;
