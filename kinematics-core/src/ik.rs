@@ -56,14 +56,14 @@ const TURN_SCALE_SHIFT: u32 = 24;
 /// elbow's reach and keep its value (the reach clamp absorbs that); farther, t6 is turned.
 const FREE_T6_SLACK: Len = LEN_PER_TENTH_MM;
 
-/// How far (0.03 mm) the wrist point may move sideways to let t1 stay near the seed's next to
-/// the shoulder singularity, where the wire's rounding would otherwise swing t1 (and t5) by a
-/// degree or more for the same pose.
-const SHOULDER_SLACK: Len = 3 * LEN_PER_TENTH_MM / 10;
+/// How far (0.05 mm) the reached point may move to let an ill-conditioned joint keep the seed's
+/// angle: t1 next to the shoulder singularity, where the wire's rounding would otherwise swing
+/// t1 (and t5) by a degree or more for the same pose, and t3 next to the stretched elbow.
+const SEED_SLACK: Len = LEN_PER_TENTH_MM / 2;
 
-/// Largest distance of the seed's shoulder angle from the nominal one that
-/// [`SHOULDER_SLACK`] can absorb (it allows under 2 deg).
-const SHOULDER_SEED_WINDOW: Angle = Angle::from_centideg(300);
+/// Largest distance of a seed angle from the nominal one that [`SEED_SLACK`] can absorb (it
+/// allows under 2 deg).
+const SEED_WINDOW: Angle = Angle::from_centideg(300);
 
 /// Wrist points farther than this (2 m) from the base axes are unreachable without further
 /// arithmetic (and keep every square inside `i64`).
@@ -158,7 +158,8 @@ pub(crate) fn solve(
     target: &Transform,
     seed_theta: &[Angle; 6],
 ) -> Result<Branches, IkError> {
-    let [seed_theta1, _, _, _, _, seed_theta6] = *seed_theta;
+    let [seed_theta1, _, seed_theta3, _, _, seed_theta6] = *seed_theta;
+    let near = |a: Angle, b: Angle| a.sub(b).0.unsigned_abs() < SEED_WINDOW.0.unsigned_abs();
     let [_, _, _, d4, d5, d6] = links.d;
     let [_, a2, a3, _, _, _] = links.a;
     let r = &target.rotation;
@@ -177,15 +178,15 @@ pub(crate) fn solve(
     let psi = atan2(wy, wx);
     // t1 = psi + 90 deg +- phi with tan(phi) = h / d4, h^2 = r^2 - d4^2. Next to the shoulder
     // singularity (h -> 0) a wrist-point error e changes h^2 by 2 r e, which swings phi widely
-    // while the pose hardly changes: keep the seed's phi if a wrist point within SHOULDER_SLACK
+    // while the pose hardly changes: keep the seed's phi if a wrist point within SEED_SLACK
     // of the target's allows it.
     let h2 = r2 - d4 * d4;
-    let h2_slack = 2 * sqrt(r2) * SHOULDER_SLACK;
+    let h2_slack = 2 * sqrt(r2) * SEED_SLACK;
     let phi = atan2(sqrt(h2), d4);
     let seed_phi = seed_theta1.sub(psi).sub(Angle::QUARTER);
     let keep_seed = |seed_side: Angle| {
         // The slack allows a few degrees at most: skip the bounds for seeds farther off.
-        seed_side.sub(phi).0.unsigned_abs() < SHOULDER_SEED_WINDOW.0.unsigned_abs()
+        near(seed_side, phi)
             && (atan2(sqrt(h2 - h2_slack), d4).0..=atan2(sqrt(h2 + h2_slack), d4).0)
                 .contains(&seed_side.0)
     };
@@ -266,8 +267,21 @@ pub(crate) fn solve(
             let sin3 = sqrt(s_len * s_len - l2) * sqrt(l2 - d_len * d_len);
             let cos3 = cos_sign * (l2 - a2 * a2 - a3 * a3);
             let toward_e = atan2(ey, ex);
+            // Next to the stretched elbow t3 is ill-conditioned too: keep the seed's t3 if it
+            // reaches within SEED_SLACK of |e| and lies on this branch's side.
+            let l2_slack = 2 * sqrt(l2) * SEED_SLACK;
+            let seed_l2 = {
+                let (_, c3) = seed_theta3.sin_cos();
+                a2 * a2 + a3 * a3 + 2 * a2 * mul(a3, c3)
+            };
             for (elbow, sign3) in [1i64, -1].into_iter().enumerate() {
-                let t3 = atan2(sign3 * sin3, cos3);
+                let mut t3 = atan2(sign3 * sin3, cos3);
+                if near(seed_theta3, t3)
+                    && (seed_theta3.0 >= 0) == (t3.0 >= 0)
+                    && (seed_l2 - l2).abs() <= l2_slack
+                {
+                    t3 = seed_theta3;
+                }
                 let (s3, c3) = t3.sin_cos();
                 let t2 = toward_e.sub(atan2(mul(a3, s3), a2 + mul(a3, c3)));
                 let t4 = t234.sub(t2).sub(t3);

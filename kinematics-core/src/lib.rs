@@ -37,13 +37,14 @@
 //! * FK: worst 0.0005 mm and 0.000001 deg before rounding to the wire (0.085 mm / 0.011 deg
 //!   after, which is the wire's own rounding).
 //! * IK of the exact FK, answers rounded to 0.01 deg: 100 % within 0.1 mm / 0.05 deg (worst
-//!   0.048 mm, 0.022 deg), singular configurations included.
-//! * IK of the FK rounded to the wire (what `get_coords` then `send_coords` does): 99.96 %;
+//!   0.050 mm, 0.022 deg), singular configurations included.
+//! * IK of the FK rounded to the wire (what `get_coords` then `send_coords` does): 99.98 %
+//!   (and where the seed already reaches the pose within 0.05 mm, the joints stay put);
 //!   the rest lie next to a singularity or a limit, where the rounding alone makes the pose
 //!   unreachable or moves its solution past the limit.
 //!
 //! Host cost (x86-64, release): FK about 0.5 us and 2 300 instructions, IK (all branches and the
-//! selection) about 2 us and 8 500 instructions per call:
+//! selection) about 2 us and 9 500 instructions per call:
 //! * `cargo bench -p kinematics-core` (criterion: FK, IK, a 27-step linear path);
 //! * `kinematics-core/benches/callgrind.sh` (instructions per call, via valgrind's callgrind:
 //!   the difference between runs of `examples/ik_count.rs` with N and with 0 calls);

@@ -502,6 +502,8 @@ fn resending_the_read_coordinates_keeps_the_joints() {
         [0, -3000, -3000, 0, 0, 0],
         [9000, -4500, -9000, 4500, 0, 0],
         [-2500, 3000, -6000, 3000, 0, 0],
+        [0, 1000, -2000, 1000, 0, 0],
+        [1234, 1000, -500, 1000, 3000, -2000],
     ] {
         let q = JointAngles(q);
         let sol = kin.inverse(&kin.forward(&q), &q).unwrap();
