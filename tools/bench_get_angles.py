@@ -4,6 +4,7 @@ time, and how many calls failed (returned -1 or anything but six angles in range
 
     cargo run --release -- --pty-link /tmp/mycobot &
     .venv/bin/python tools/bench_get_angles.py /tmp/mycobot [--calls 10000]
+    .venv/bin/python tools/bench_get_angles.py --tcp 127.0.0.1:9000   # with --tcp 127.0.0.1:9000
 
 Targets: >= 300 round trips/s (the 115200 baud wire allows ~520/s for a 5-byte request and a
 17-byte reply) and zero failed calls. Exits non-zero if a target is missed.
@@ -14,7 +15,7 @@ import statistics
 import sys
 import time
 
-from pymycobot import MyCobot280
+from pymycobot import MyCobot280, MyCobot280Socket
 
 LIMITS = [168, 140, 150, 150, 160, 180]
 TARGET_RATE = 300.0
@@ -32,9 +33,14 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("port", nargs="?", default="/tmp/mycobot", help="serial device or pty link")
     parser.add_argument("--calls", type=int, default=10_000, help="number of get_angles calls")
+    parser.add_argument("--tcp", metavar="HOST:PORT", help="use MyCobot280Socket on this address instead")
     args = parser.parse_args()
 
-    mc = MyCobot280(args.port)
+    if args.tcp:
+        host, port = args.tcp.rsplit(":", 1)
+        mc = MyCobot280Socket(host, int(port))
+    else:
+        mc = MyCobot280(args.port)
     failures = []
     latencies_ms = []
     start = time.perf_counter()
