@@ -24,9 +24,14 @@ use protocol_core::{BytePort, Frame, FrameDecoder, timing};
 use crate::config::{BasicConfig, EchoMode};
 
 /// Requests that may wait behind the one in flight. pymycobot sends one request at a time
-/// and waits for its reply; 8 absorbs clients that pipeline a few without letting a flood
-/// queue seconds of stale commands.
-pub const REQUEST_QUEUE_DEPTH: usize = 8;
+/// and waits for its reply; 32 absorbs a client that pipelines a burst (a request arrives
+/// every 0.43 ms at 115200, an exchange with the Atom takes about 1 ms). Staleness is bounded
+/// by [`MAX_QUEUED_US`], not by the depth.
+pub const REQUEST_QUEUE_DEPTH: usize = 32;
+/// A request that has waited in the queue this long is dropped unsent, in microseconds: the
+/// client has given up on it (pymycobot resends after 0.5 s) and a command that old must not
+/// move the arm.
+pub const MAX_QUEUED_US: u64 = timing::HOST_REPLY_DEADLINE_US;
 /// How long after the transmitter went idle the rest of an echo that has started (or one the
 /// wiring is known to give) may still arrive, in microseconds: two byte times at 1 Mbaud, the
 /// receiver's latency.
@@ -60,6 +65,8 @@ pub(crate) enum Origin {
 pub(crate) struct Request {
     pub(crate) frame: Frame,
     pub(crate) origin: Origin,
+    /// When it was queued.
+    pub(crate) queued_us: u64,
 }
 
 /// What happened to a request, for the caller to act on.
@@ -71,6 +78,8 @@ pub(crate) enum Event {
     Timeout(Request),
     /// `request` collided on every attempt and was given up.
     GaveUp(Request),
+    /// `request` waited in the queue longer than [`MAX_QUEUED_US`] and was dropped unsent.
+    Expired(Request),
     /// A transmission collided and will be repeated.
     Collision,
     /// A frame from the bus answered nothing outstanding and was dropped.
@@ -252,9 +261,13 @@ impl Forwarder {
         {
             on_event(Event::Timeout(done.request));
         }
-        if self.current.is_none()
+        while self.current.is_none()
             && let Some(request) = self.queue.pop_front()
         {
+            if now_us.saturating_sub(request.queued_us) > MAX_QUEUED_US {
+                on_event(Event::Expired(request));
+                continue;
+            }
             let mut wire = Vec::new();
             let mut buf = [0u8; MAX_FRAME_BYTES];
             if let Some(bytes) = request.frame.encode(&mut buf).and_then(|n| buf.get(..n)) {

@@ -195,7 +195,7 @@ impl Basic {
                 TransponderMode::Framed => {
                     let mut next = self.host.push(byte);
                     while let Some(frame) = next {
-                        self.on_host_frame(frame, io);
+                        self.on_host_frame(now_us, frame, io);
                         next = self.host.next_frame();
                     }
                 }
@@ -210,7 +210,7 @@ impl Basic {
             TransponderMode::Framed => {
                 let mut next = self.host.check_gap(now_us);
                 while let Some(frame) = next {
-                    self.on_host_frame(frame, io);
+                    self.on_host_frame(now_us, frame, io);
                     next = self.host.next_frame();
                 }
             }
@@ -220,7 +220,7 @@ impl Basic {
         }
     }
 
-    fn on_host_frame<I: BasicIo>(&mut self, frame: Frame, io: &mut I) {
+    fn on_host_frame<I: BasicIo>(&mut self, now_us: u64, frame: Frame, io: &mut I) {
         if self.mode == TransponderMode::Transparent {
             // A frame completed by the same byte as the one that entered transparent mode:
             // it is raw data now.
@@ -252,6 +252,7 @@ impl Basic {
         let request = Request {
             frame,
             origin: Origin::Host,
+            queued_us: now_us,
         };
         if self.forwarder.enqueue(request).is_err() {
             self.supervisor.error(BasicError::QueueFull { cmd });

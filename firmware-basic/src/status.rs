@@ -27,7 +27,8 @@ pub enum BasicError {
         /// The request's command byte.
         cmd: u8,
     },
-    /// The request queue was full; request `cmd` from the host was dropped.
+    /// Request `cmd` from the host was dropped unsent: the request queue was full, or it
+    /// waited in the queue until the client had given up on it (0.5 s).
     QueueFull {
         /// The request's command byte.
         cmd: u8,

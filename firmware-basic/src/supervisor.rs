@@ -92,6 +92,7 @@ impl Supervisor {
             // Cannot fail: no data.
             frame: Frame::new(cmd, &[]).unwrap_or_default(),
             origin,
+            queued_us: now_us,
         })
     }
 
@@ -131,6 +132,11 @@ impl Supervisor {
             Event::GaveUp(request) => {
                 status.collisions = status.collisions.wrapping_add(1);
                 status.last_error = Some(BasicError::BusCollisions {
+                    cmd: request.frame.cmd(),
+                });
+            }
+            Event::Expired(request) => {
+                status.last_error = Some(BasicError::QueueFull {
                     cmd: request.frame.cmd(),
                 });
             }

@@ -174,21 +174,31 @@ fn pipelined_requests_are_forwarded_one_at_a_time_and_answered_in_order() {
 }
 
 #[test]
-fn a_flood_beyond_the_queue_drops_requests_but_keeps_working() {
+fn a_flood_to_a_dead_atom_neither_wedges_nor_replays_stale_commands() {
     let mut rig = Rig::quiet(true);
     rig.atom = Box::new(|_| None);
-    for _ in 0..20 {
-        rig.host.send(&frame(GET_ANGLES, &[]));
+    for _ in 0..40 {
+        rig.host.send(&frame(
+            SEND_ANGLES,
+            &[0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 50],
+        ));
     }
-    rig.run_us(5_000);
+    rig.step_ns = 5_000;
+    // 40 requests of 18 bytes take 63 ms to arrive at 115200.
+    rig.run_us(100_000);
     assert_eq!(
         rig.basic.status().last_error,
-        Some(BasicError::QueueFull { cmd: GET_ANGLES })
+        Some(BasicError::QueueFull { cmd: SEND_ANGLES }),
+        "more than the queue holds"
     );
+    rig.run_us(1_000_000);
+    // Each forwarded request waits out its reply timeout; the rest expire unsent once the
+    // client has given up on them (0.5 s) instead of moving the arm seconds later.
+    let timeout_us = BasicConfig::default().reply_timeout_us;
+    assert_eq!(rig.atom_got.len() as u64, 500_000 / timeout_us + 1);
+    // The Atom is back: the next command is answered at once.
     rig.atom = common::ack_everything();
-    rig.step_ns = 20_000;
-    rig.run_us(BasicConfig::default().reply_timeout_us * 12);
-    rig.host.from_basic.clear();
+    rig.step_ns = 1_000;
     rig.host.send(&frame(IS_POWERED_ON, &[]));
     rig.run_us(5_000);
     assert_eq!(rig.host.received(), frame(IS_POWERED_ON, &[1]));
