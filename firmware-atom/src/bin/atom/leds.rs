@@ -1,6 +1,6 @@
 //! The Atom's WS2812 RGB LEDs, driven by one RMT channel: every data bit is one RMT pulse code.
 
-use crate::ws2812::{BITS_PER_LED, led_bits};
+use crate::ws2812::{BITS_PER_LED, dimmed, led_bits};
 use esp_hal::{
     Blocking,
     gpio::{Level, interconnect::PeripheralOutput},
@@ -45,10 +45,12 @@ impl<'d> Leds<'d> {
         })
     }
 
-    /// Shows one colour on every LED. Blocks for the chain's wire time (0.75 ms for 25 LEDs).
+    /// Shows one colour on every LED, dimmed to a safe level ([`dimmed`]). Blocks for the
+    /// chain's wire time (0.75 ms for 25 LEDs).
     pub fn fill(&mut self, red: u8, green: u8, blue: u8) {
+        let bits = led_bits(dimmed(red), dimmed(green), dimmed(blue));
         let (data, _end_marker) = self.pulses.split_at_mut(PULSE_COUNT - 1);
-        for (pulse, bit) in data.iter_mut().zip(led_bits(red, green, blue).cycle()) {
+        for (pulse, bit) in data.iter_mut().zip(bits.cycle()) {
             *pulse = if bit { ONE } else { ZERO };
         }
         // A failed transmission leaves the LEDs as they were; the next fill tries again.

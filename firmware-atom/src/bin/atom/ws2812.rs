@@ -3,6 +3,16 @@
 
 /// Bits sent per LED.
 pub const BITS_PER_LED: usize = 24;
+/// Brightest level a colour component is driven at, of 255. M5Stack advises keeping the Atom
+/// Matrix at 20 or below: its 25 LEDs at full brightness overheat the panel and draw over 1 A.
+pub const MAX_LEVEL: u8 = 20;
+
+/// The level actually driven for a requested colour component (0..255): scaled onto
+/// 0..[`MAX_LEVEL`], rounding up so that every lit component stays lit.
+pub fn dimmed(level: u8) -> u8 {
+    let scaled = (u16::from(level) * u16::from(MAX_LEVEL)).div_ceil(255);
+    u8::try_from(scaled).unwrap_or(MAX_LEVEL)
+}
 
 /// The bits that make one LED show (`red`, `green`, `blue`), in wire order.
 pub fn led_bits(red: u8, green: u8, blue: u8) -> impl Clone + Iterator<Item = bool> {
@@ -21,6 +31,14 @@ mod tests {
             .enumerate()
             .filter_map(|(i, bit)| bit.then_some(i))
             .collect()
+    }
+
+    #[test]
+    fn colours_are_dimmed_to_a_safe_level_without_going_dark() {
+        assert_eq!(dimmed(0), 0);
+        assert_eq!(dimmed(1), 1);
+        assert_eq!(dimmed(128), 11);
+        assert_eq!(dimmed(255), MAX_LEVEL);
     }
 
     #[test]
