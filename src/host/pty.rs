@@ -38,7 +38,7 @@ impl PseudoTerminal {
         let slave = OpenOptions::new()
             .read(true)
             .write(true)
-            .custom_flags(libc_o_noctty())
+            .custom_flags(o_noctty())
             .open(&slave_path)?;
         let mut termios = tcgetattr(&slave)?;
         cfmakeraw(&mut termios);
@@ -90,7 +90,7 @@ impl AsFd for PseudoTerminal {
 
 /// `O_NOCTTY` as the raw flag `OpenOptionsExt::custom_flags` wants: opening the slave must not
 /// make it our controlling terminal (a client's hang-up would then signal us).
-fn libc_o_noctty() -> i32 {
+fn o_noctty() -> i32 {
     OFlag::O_NOCTTY.bits()
 }
 

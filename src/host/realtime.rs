@@ -107,11 +107,6 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
         &self.pty
     }
 
-    /// The TCP server, if one was asked for.
-    pub fn tcp(&self) -> Option<&TcpServer> {
-        self.tcp.as_ref()
-    }
-
     /// Runs until `stop` is set (by a signal handler), then returns the robot.
     pub fn run(mut self, stop: &AtomicBool) -> io::Result<R> {
         // Virtual time = virtual_at_sync + wall time since wall_sync.
