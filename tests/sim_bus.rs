@@ -3,9 +3,10 @@
 
 mod sim_support;
 
-use open_mycobot::sim::{BusByte, HostLink, RobotConfig, VirtualRobot};
-use protocol_core::command::{Reply, Request};
+use open_mycobot::sim::{HostLink, RobotConfig, StationId, VirtualRobot};
+use protocol_core::command::{JointId, Reply, Request};
 use protocol_core::timing::HOST_REPLY_DEADLINE_US;
+use protocol_core::units::Centideg;
 use protocol_core::{Frame, FrameDecoder};
 use sim_support::*;
 
@@ -58,28 +59,92 @@ fn works_whether_or_not_the_boards_hear_their_own_echo() {
 }
 
 /// Sends `request`, throws `noise` onto the bus `delay_us` later, and returns every frame the
-/// host got within pymycobot's reply deadline.
+/// host got: up to the first one (within pymycobot's reply deadline) and 30 ms after it.
 fn exchange_with_noise(
     robot: &mut VirtualRobot,
     request: &Frame,
     delay_us: u64,
     noise: &[u8],
 ) -> Vec<Frame> {
+    let deadline = robot.now_us() + HOST_REPLY_DEADLINE_US;
     robot.host_write(&request.to_bytes());
     robot.run_for(delay_us);
     robot.inject_bus_noise(noise);
-    robot.run_for(HOST_REPLY_DEADLINE_US - delay_us);
-    let mut bytes = Vec::new();
-    robot.host_read(&mut bytes);
+    let mut decoder = FrameDecoder::new();
     let mut frames = Vec::new();
-    FrameDecoder::new().feed(&bytes, |f| frames.push(f));
+    let mut bytes = Vec::new();
+    while frames.is_empty() && robot.now_us() < deadline {
+        robot.run_for(100);
+        bytes.clear();
+        robot.host_read(&mut bytes);
+        decoder.feed(&bytes, |f| frames.push(f));
+    }
+    robot.run_for(30_000);
+    bytes.clear();
+    robot.host_read(&mut bytes);
+    decoder.feed(&bytes, |f| frames.push(f));
     frames
+}
+
+/// Waits until `station` is `bytes_in` bytes into a host frame on the bus, then puts three
+/// bytes of noise over it. Returns the first frame the host gets within the reply deadline.
+fn collide_with(
+    robot: &mut VirtualRobot,
+    station: StationId,
+    bytes_in: usize,
+    request: &Request,
+) -> Option<Frame> {
+    robot.bus_mut().set_tracing(true);
+    robot.host_write(&request.to_frame().to_bytes());
+    let deadline = robot.now_us() + HOST_REPLY_DEADLINE_US;
+    let mut sent = Vec::new();
+    while sent.len() < bytes_in {
+        if robot.now_us() >= deadline {
+            return None;
+        }
+        robot.run_for(5);
+        let trace = robot.bus_mut().take_trace();
+        for b in trace.iter().filter(|b| b.from == station) {
+            // Count from the start of a host frame: FE FE ...
+            if b.byte == 0xFE && sent.iter().all(|&x| x == 0xFE) && sent.len() < 2 {
+                sent.push(b.byte);
+            } else if sent.len() >= 2 {
+                sent.push(b.byte);
+            } else {
+                sent.clear();
+            }
+        }
+    }
+    let collisions_before = robot.bus().collisions();
+    robot.inject_bus_noise(&[0x00, 0xFE, 0x55]);
+    robot.bus_mut().set_tracing(false);
+    let mut decoder = FrameDecoder::new();
+    let mut found = None;
+    while found.is_none() && robot.now_us() < deadline {
+        robot.run_for(100);
+        let mut bytes = Vec::new();
+        robot.host_read(&mut bytes);
+        decoder.feed(&bytes, |f| {
+            found.get_or_insert(f);
+        });
+    }
+    assert!(
+        robot.bus().collisions() > collisions_before,
+        "the noise missed"
+    );
+    found
 }
 
 #[test]
 fn bus_noise_loses_nothing() {
+    for seed in [0x5eed, 3 * 7919, 0xC0FFEE] {
+        noisy_session(seed);
+    }
+}
+
+fn noisy_session(seed: u64) {
     let mut robot = arm();
-    let mut rng = Lcg(0x5eed);
+    let mut rng = Lcg(seed);
     let requests = [
         Request::GetAngles,
         Request::IsPowerOn,
@@ -105,7 +170,8 @@ fn bus_noise_loses_nothing() {
         assert_eq!(
             frames.len(),
             1,
-            "round {round}: {request:?} with {noise:02x?} after {delay_us} us got {frames:?}"
+            "seed {seed} round {round}: {request:?} with {noise:02x?} after {delay_us} us got \
+             {frames:?}"
         );
         assert_eq!(frames[0].cmd(), frame.cmd(), "round {round}");
         assert!(
@@ -129,41 +195,49 @@ fn a_request_that_collides_on_the_bus_is_still_answered() {
     let mut robot = arm();
     let basic = robot.basic_station().expect("basic");
     for request in [Request::GetAngles, Request::IsPowerOn, Request::GetEncoders] {
-        let frame = request.to_frame();
-        robot.bus_mut().set_tracing(true);
-        robot.host_write(&frame.to_bytes());
-        // Wait for the Basic to be two bytes into forwarding, then talk over it.
-        let mut trace = Vec::new();
-        let deadline = robot.now_us() + HOST_REPLY_DEADLINE_US;
-        while trace.iter().filter(|b: &&BusByte| b.from == basic).count() < 2 {
-            assert!(
-                robot.now_us() < deadline,
-                "the Basic never forwarded {request:?}"
-            );
-            robot.run_for(5);
-            trace.extend(robot.bus_mut().take_trace());
-        }
-        let collisions_before = robot.bus().collisions();
-        robot.inject_bus_noise(&[0x00, 0xFE, 0x55]);
-        let reply = {
-            let mut decoder = FrameDecoder::new();
-            let mut found = None;
-            let deadline = robot.now_us() + HOST_REPLY_DEADLINE_US;
-            while found.is_none() && robot.now_us() < deadline {
-                robot.run_for(100);
-                let mut bytes = Vec::new();
-                robot.host_read(&mut bytes);
-                decoder.feed(&bytes, |f| {
-                    found.get_or_insert(f);
-                });
-            }
-            found
-        };
-        robot.bus_mut().set_tracing(false);
-        assert!(robot.bus().collisions() > collisions_before, "noise missed");
-        let reply = reply.unwrap_or_else(|| panic!("{request:?} lost after a collision"));
-        assert_eq!(reply.cmd(), frame.cmd());
+        let reply = collide_with(&mut robot, basic, 2, &request)
+            .unwrap_or_else(|| panic!("{request:?} lost after a collision"));
+        assert_eq!(reply.cmd(), request.to_frame().cmd());
         assert!(Reply::parse(request.reply_kind(), &reply).is_ok());
         assert_silent_for(&mut robot, HostLink::Basic, 200_000);
     }
+}
+
+#[test]
+fn a_reply_that_collides_on_the_bus_still_reaches_the_host() {
+    let mut robot = arm();
+    let atom = robot.atom_station();
+    for request in [Request::GetAngles, Request::IsPowerOn, Request::GetEncoders] {
+        let reply = collide_with(&mut robot, atom, 3, &request)
+            .unwrap_or_else(|| panic!("the reply to {request:?} was lost after a collision"));
+        assert_eq!(reply.cmd(), request.to_frame().cmd());
+        assert!(Reply::parse(request.reply_kind(), &reply).is_ok());
+        assert_silent_for(&mut robot, HostLink::Basic, 200_000);
+    }
+}
+
+#[test]
+fn an_incremental_jog_whose_reply_collides_moves_once_and_is_answered() {
+    let mut robot = arm();
+    let atom = robot.atom_station();
+    let jog = Request::JogIncrementAngle {
+        joint: JointId::new(1).expect("joint 1"),
+        increment: Centideg(1_000),
+        speed: speed(50),
+    };
+    // The Basic may not repeat an incremental jog, so only the Atom can save this reply.
+    let reply = collide_with(&mut robot, atom, 3, &jog);
+    // The arm moves 10 degrees, once, whatever happened to the reply.
+    assert!(
+        robot.run_until_true(MOTION_TIMEOUT_US, |r| r.measured_angles()[0].0
+            >= 1_000 - ANGLE_TOLERANCE)
+    );
+    robot.run_for(2_000_000);
+    assert_angles_near(
+        robot.measured_angles(),
+        degrees([10.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        "after one jog",
+    );
+    let reply = reply.expect("the jog's reply was lost: pymycobot would resend it and jog twice");
+    assert_eq!(reply.cmd(), jog.to_frame().cmd());
 }
