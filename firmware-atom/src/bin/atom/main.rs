@@ -9,6 +9,11 @@
 #![no_main]
 #![deny(unsafe_code)]
 
+#[cfg(not(target_os = "none"))]
+compile_error!(
+    "the atom board binary builds only for a chip: `cargo build-atom-c3` or `cargo +esp build-atom` (docs/boards.md)"
+);
+
 mod board_io;
 mod leds;
 mod pins;

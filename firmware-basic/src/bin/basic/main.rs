@@ -10,6 +10,11 @@
 #![no_main]
 #![deny(unsafe_code)]
 
+#[cfg(not(target_os = "none"))]
+compile_error!(
+    "the basic board binary builds only for a chip: `cargo build-basic-c3` or `cargo +esp build-basic` (docs/boards.md)"
+);
+
 mod board_io;
 mod pins;
 mod screen;
