@@ -87,12 +87,14 @@ class LimitTest(RobotTestCase):
         self.assertEqual(self.mc.get_joint_min_angle(1), -20.0)
 
         self.mc.send_angle(1, 50, 100)
+        self.assertEqual(self.mc.get_error_information(), 1, "error code after joint 1 was sent past its max")
         time.sleep(0.6)
         self.assertLessEqual(self.mc.get_angles()[0], 30.2, "moved past the user's max limit")
+        self.mc.clear_error_information()
         self.mc.send_angles([-40, 0, 0, 0, 0, 0], 100)
+        self.assertEqual(self.mc.get_error_information(), 1, "error code after joint 1 was sent past its min")
         time.sleep(0.6)
         self.assertGreaterEqual(self.mc.get_angles()[0], -20.2, "moved past the user's min limit")
-        self.assertIn(self.mc.get_error_information(), (0, 1), "error code for a joint-1 limit")
 
         # Inside the new limits it still moves.
         self.mc.clear_error_information()
