@@ -44,6 +44,18 @@ const LOST_SERVO_PROBE_ROUNDS: u8 = 8;
 /// steps/s^2, the servo reaches full joint speed in under 70 ms.
 const STEP_ACCEL_REGISTER: u8 = 254;
 
+/// First register of the state read: torque enable (40) through present current (69..70), so
+/// one READ per servo confirms torque and goal as well as the present state. 31 bytes: a
+/// transaction of about 0.5 ms, a full round of seven servos in about 4 ms (250 Hz).
+const STATE_READ_ADDR: u8 = reg::TORQUE_ENABLE;
+/// Length of the state read (registers 40..=70).
+const STATE_READ_LEN: u8 = reg::PRESENT_CURRENT + 2 - reg::TORQUE_ENABLE;
+
+/// Corrective writes per servo and command when the read-back disagrees (a lost write is
+/// re-sent; a servo that keeps disagreeing, e.g. a goal clamped by its own position limits, is
+/// left alone after this many).
+const MAX_REPAIRS: u8 = 3;
+
 /// How long a fresh goal counts as "moving" before the servo's own moving flag is read back:
 /// several refresh rounds (a round takes about 3 ms).
 const GOAL_CONFIRM_US: u64 = 30_000;
@@ -167,7 +179,11 @@ pub struct Atom {
     pub(crate) limits: [JointLimit; JOINTS],
     pub(crate) speed_percent: u8,
     pub(crate) health: [ServoHealth; SERVOS],
-    pub(crate) last_goal: [Option<Steps>; SERVOS],
+    /// The goal each servo was last sent (checked by the choke point), for read-back.
+    pub(crate) last_goal: [Option<Goal>; SERVOS],
+    /// Corrective writes sent to each servo since its last command (bounded by
+    /// [`MAX_REPAIRS`]).
+    repairs: [u8; SERVOS],
     /// When each servo last got a goal (it may not report moving until its next state read).
     last_goal_us: [u64; SERVOS],
     /// The time of the current poll.
@@ -246,6 +262,7 @@ impl Atom {
             speed_percent: 100,
             health,
             last_goal: [None; SERVOS],
+            repairs: [0; SERVOS],
             last_goal_us: [0; SERVOS],
             now_us: 0,
             activity: Activity::Idle,
@@ -431,8 +448,8 @@ impl Atom {
             let id = *self.config.servo_ids.get(index)?;
             return Some(Op::Read {
                 id,
-                addr: reg::STATE_BLOCK,
-                count: reg::STATE_BLOCK_LEN,
+                addr: STATE_READ_ADDR,
+                count: STATE_READ_LEN,
             });
         }
         None
@@ -444,8 +461,8 @@ impl Atom {
         let is_state_read = matches!(
             op,
             Op::Read {
-                addr: reg::STATE_BLOCK,
-                count: reg::STATE_BLOCK_LEN,
+                addr: STATE_READ_ADDR,
+                count: STATE_READ_LEN,
                 ..
             }
         );
@@ -453,7 +470,12 @@ impl Atom {
         if is_state_read && !job_matches {
             if let Some(h) = index.and_then(|i| self.health.get_mut(i)) {
                 match &outcome {
-                    Outcome::Answered(p) => apply_state(h, p),
+                    Outcome::Answered(p) => {
+                        apply_state(h, p);
+                        if let Some(i) = index {
+                            self.verify(i);
+                        }
+                    }
                     _ => {
                         h.comm_errors = h.comm_errors.wrapping_add(1);
                         h.misses = h.misses.saturating_add(1);
@@ -537,7 +559,10 @@ impl Atom {
             if let Some(g) = new {
                 *slot = Some(*g);
                 if let Some(last) = self.last_goal.get_mut(i) {
-                    *last = Some(g.position);
+                    *last = Some(*g);
+                }
+                if let Some(r) = self.repairs.get_mut(i) {
+                    *r = 0;
                 }
                 if let Some(t) = self.last_goal_us.get_mut(i) {
                     *t = self.now_us;
@@ -568,6 +593,9 @@ impl Atom {
             .is_some_and(|op| self.queue_op(op, Then::Nothing));
         if queued && let Some(h) = self.health.get_mut(index) {
             h.torque_on = on;
+            if let Some(r) = self.repairs.get_mut(index) {
+                *r = 0;
+            }
         }
         queued
     }
@@ -658,7 +686,7 @@ impl Atom {
             .get(j)
             .copied()
             .flatten()
-            .map(|s| self.config.steps_to_angle(j, s))
+            .map(|g| self.config.steps_to_angle(j, g.position))
     }
 
     /// The target being executed (or the present angles when idle).
@@ -831,7 +859,9 @@ impl Atom {
             .get(index)
             .copied()
             .flatten()
-            .is_some_and(|g| (i32::from(g.0) - i32::from(h.position.0)).abs() > IN_POSITION_STEPS);
+            .is_some_and(|g| {
+                (i32::from(g.position.0) - i32::from(h.position.0)).abs() > IN_POSITION_STEPS
+            });
         h.answering && (h.moving || (recent && far))
     }
 
@@ -911,9 +941,9 @@ impl Atom {
     }
 }
 
-/// Applies a state-block read (`servo-bus.md`: addresses 56..=70) to a servo's health.
+/// Applies a state read (registers 40..=70) to a servo's health.
 fn apply_state(h: &mut ServoHealth, p: &Packet) {
-    let at = |addr: u8| usize::from(addr - reg::STATE_BLOCK);
+    let at = |addr: u8| usize::from(addr - STATE_READ_ADDR);
     let byte = |addr: u8| p.params().get(at(addr)).copied().unwrap_or(0);
     let word = |addr: u8| p.u16_at(at(addr)).unwrap_or(0);
     h.answering = true;
@@ -927,6 +957,59 @@ fn apply_state(h: &mut ServoHealth, p: &Packet) {
     h.fault_bits = p.code() | byte(reg::STATUS);
     h.moving = byte(reg::MOVING) != 0;
     h.current_raw = sign_magnitude(word(reg::PRESENT_CURRENT), 15);
+    h.torque_reported = byte(reg::TORQUE_ENABLE) != 0;
+    h.goal_reported = Steps(sign_magnitude(word(reg::GOAL_POSITION), 15));
+}
+
+impl Atom {
+    /// Compares what servo `index` reports with what it was told (torque, goal) and re-sends
+    /// what got lost: a SYNC WRITE has no answer, and a collision on the shared wire can
+    /// swallow it or a torque write. At most [`MAX_REPAIRS`] corrections per command, and
+    /// none while a command for that servo is still on its way.
+    fn verify(&mut self, index: usize) {
+        let Some(&id) = self.config.servo_ids.get(index) else {
+            return;
+        };
+        let Some(h) = self.health.get(index).copied() else {
+            return;
+        };
+        let pending_goal = self
+            .pending_goals
+            .as_ref()
+            .is_some_and(|p| p.goals().get(index).copied().flatten().is_some());
+        let pending_job = self.jobs.iter().any(|j| j.op.id() == id);
+        let repairs = self.repairs.get(index).copied().unwrap_or(MAX_REPAIRS);
+        if pending_goal || pending_job || repairs >= MAX_REPAIRS {
+            return;
+        }
+        if h.torque_reported != h.torque_on {
+            if let Some(op) = Op::write(id, reg::TORQUE_ENABLE, &[u8::from(h.torque_on)]) {
+                self.queue_op(op, Then::Nothing);
+            }
+        } else if h.torque_on
+            && let Some(goal) = self.last_goal.get(index).copied().flatten()
+            && (i32::from(goal.position.0) - i32::from(h.goal_reported.0)).abs() > 1
+        {
+            let mut merged: GoalSet = self
+                .pending_goals
+                .as_ref()
+                .map(|p| *p.goals())
+                .unwrap_or([None; SERVOS]);
+            if let Some(slot) = merged.get_mut(index) {
+                *slot = Some(goal);
+            }
+            // Through the choke point again: the limits may have changed since.
+            match safety::check(&self.config, &self.limits, self.powered, merged) {
+                Ok(safe) => self.pending_goals = Some(safe),
+                Err(_) => return,
+            }
+        } else {
+            return;
+        }
+        if let Some(r) = self.repairs.get_mut(index) {
+            *r += 1;
+        }
+    }
 }
 
 impl Atom {

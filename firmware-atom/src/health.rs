@@ -2,7 +2,8 @@
 
 use protocol_core::units::Steps;
 
-/// The latest state read from one servo (present-state block, `servo-bus.md`).
+/// The latest state read from one servo (registers 40..=70: torque, goal, present state;
+/// `servo-bus.md`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ServoHealth {
     /// True while the servo answers; false after
@@ -26,8 +27,12 @@ pub struct ServoHealth {
     pub temperature_c: u8,
     /// The servo's moving flag.
     pub moving: bool,
-    /// Whether the Atom last switched this servo's torque on.
+    /// Whether the Atom last switched this servo's torque on (what 0x50 reports).
     pub torque_on: bool,
+    /// The servo's own torque-enable register, as last read.
+    pub torque_reported: bool,
+    /// The servo's own goal-position register, as last read.
+    pub goal_reported: Steps,
     /// Failed transactions (timeouts and bad checksums) since boot. Wraps.
     pub comm_errors: u32,
     /// Consecutive missed state reads.

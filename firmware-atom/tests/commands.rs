@@ -407,3 +407,23 @@ fn own_reply_heard_late_is_not_taken_for_a_request() {
     rig.run_ms(5);
     assert_eq!(rig.bus.replies.len(), replies, "no reply to our own reply");
 }
+
+#[test]
+fn lost_goal_and_torque_writes_are_repaired_from_the_read_back() {
+    let mut rig = Rig::new();
+    // Servo 3 misses the SYNC WRITE of the move (a collision on the wire).
+    rig.bus.servo(3).deaf_to = 1;
+    let mut data = be(&[1000, 1000, 1000, 0, 0, 0]);
+    data.push(100);
+    assert_eq!(rig.ask(SEND_ANGLES, &data), [1]);
+    rig.run_ms(1500);
+    assert!(close(&angles(&mut rig)[..3], &[1000, 1000, 1000], 10));
+    // Servo 2 misses the torque-off of release all servos.
+    rig.bus.servo(2).deaf_to = 1;
+    assert_eq!(rig.ask(0x13, &[]), [1]);
+    rig.run_ms(30);
+    assert!(!rig.bus.servo(2).torque_on(), "torque-off re-sent");
+    assert_eq!(rig.ask(0x10, &[]), [1]);
+    rig.run_ms(30);
+    assert!(rig.bus.servo(2).torque_on());
+}

@@ -36,6 +36,8 @@ pub struct FakeServo {
     pub drop_answers: u32,
     /// Answers to send with a wrong checksum (counted down).
     pub corrupt_answers: u32,
+    /// Instructions to ignore from now on (counted down): a write lost in a collision.
+    pub deaf_to: u32,
     /// Goals received (position register writes), for the safety checks.
     pub goals: Vec<i16>,
     pub last_update_us: u64,
@@ -57,6 +59,7 @@ impl FakeServo {
             present: true,
             drop_answers: 0,
             corrupt_answers: 0,
+            deaf_to: 0,
             goals: Vec::new(),
             last_update_us: 0,
         };
@@ -265,6 +268,10 @@ impl FakeBus {
                     if let Some(data) = instr.sync_write_data_for(s.id)
                         && s.present
                     {
+                        if s.deaf_to > 0 {
+                            s.deaf_to -= 1;
+                            continue;
+                        }
                         let addr = match instr {
                             Instruction::SyncWrite { addr, .. } => addr,
                             _ => unreachable!(),
@@ -287,11 +294,16 @@ impl FakeBus {
             _ => {
                 let id = packet.id();
                 if let Instruction::Read { addr, .. } = instr
-                    && addr == reg::STATE_BLOCK
+                    && addr <= reg::STATE_BLOCK
                 {
                     self.state_reads.push((id as usize - 1, end_us));
                 }
                 if let Some(s) = self.servos.iter_mut().find(|s| s.id == id && s.present)
+                    && matches!(instr, Instruction::Write { .. })
+                    && s.deaf_to > 0
+                {
+                    s.deaf_to -= 1;
+                } else if let Some(s) = self.servos.iter_mut().find(|s| s.id == id && s.present)
                     && let Some(p) = s.execute(&instr, end_us)
                 {
                     if s.drop_answers > 0 {
