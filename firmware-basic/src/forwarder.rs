@@ -235,11 +235,15 @@ impl Forwarder {
 
     /// Checks deadlines and the transmitter; starts the next transmission when the wire
     /// allows. Call after the bytes that arrived have been passed to [`Self::on_bus_byte`].
+    /// `room_for_reply` is false while the host link could not take another reply: the next
+    /// request then waits in the queue (a reply is often longer than its request, so a client
+    /// that pipelines requests would otherwise overrun the host link).
     pub(crate) fn poll<B: BytePort>(
         &mut self,
         now_us: u64,
         bus: &mut B,
         config: &BasicConfig,
+        room_for_reply: bool,
         mut on_event: impl FnMut(Event),
     ) {
         if self.decoder.has_partial()
@@ -262,6 +266,7 @@ impl Forwarder {
             on_event(Event::Timeout(done.request));
         }
         while self.current.is_none()
+            && room_for_reply
             && let Some(request) = self.queue.pop_front()
         {
             if now_us.saturating_sub(request.queued_us) > MAX_QUEUED_US {

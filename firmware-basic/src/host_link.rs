@@ -70,6 +70,11 @@ impl HostLink {
         self.decoder = FrameDecoder::new();
     }
 
+    /// True if a reply frame of any size still fits in the queue.
+    pub(crate) fn has_room_for_frame(&self) -> bool {
+        HOST_TX_CAPACITY - self.tx.len() >= MAX_FRAME_BYTES
+    }
+
     /// Queues a frame for the host, whole or not at all; false if there was no room.
     pub(crate) fn send_frame(&mut self, frame: &Frame) -> bool {
         let mut buf = [0u8; MAX_FRAME_BYTES];

@@ -116,10 +116,12 @@ impl Basic {
                     // Cannot fail: the queue is empty.
                     let _ = self.forwarder.enqueue(request);
                 }
+                let room_for_reply = self.host.has_room_for_frame();
                 let (supervisor, link) = (&mut self.supervisor, &mut self.host);
-                self.forwarder.poll(now_us, bus, &self.config, |e| {
-                    supervisor.on_event(now_us, e, link)
-                });
+                self.forwarder
+                    .poll(now_us, bus, &self.config, room_for_reply, |e| {
+                        supervisor.on_event(now_us, e, link)
+                    });
             }
             TransponderMode::Transparent => {
                 let quiet_us = self.forwarder.quiet_for_us(now_us);

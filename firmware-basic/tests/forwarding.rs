@@ -383,3 +383,20 @@ fn a_valid_reply_right_after_a_garbled_one_is_taken_without_asking_again() {
     assert_eq!(rig.atom_got.len(), 1);
     assert_eq!(rig.host.received(), frame(IS_POWERED_ON, &[1]));
 }
+
+#[test]
+fn fifty_pipelined_requests_get_fifty_replies() {
+    let mut rig = Rig::quiet(true);
+    rig.atom_delay_ns = 100_000;
+    let mut burst = Vec::new();
+    for _ in 0..50 {
+        burst.extend(frame(GET_ANGLES, &[]));
+    }
+    rig.step_ns = 2_000;
+    rig.host.send(&burst);
+    // The replies (17 bytes each) need 74 ms of host link; the requests arrive in 22 ms.
+    rig.run_us(150_000);
+    assert_eq!(rig.host_frames().len(), 50);
+    assert_eq!(rig.atom_got.len(), 50);
+    assert_eq!(rig.basic.status().last_error, None);
+}
