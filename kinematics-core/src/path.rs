@@ -1,15 +1,24 @@
 //! Straight-line Cartesian motion (move mode 1, jog coord): the position moves along the line,
 //! the orientation turns about the one axis of the shortest rotation, and every step is solved
-//! with the previous step as seed, so the arm stays on one branch. A step that has no solution,
-//! or whose solution would make a joint jump, stops the path instead of being executed.
+//! with the previous step as seed, so the arm stays on one branch. Where a step would move a
+//! joint more than the per-step limit (next to a singularity joints speed up), the step is
+//! halved, down to 1/64: the path slows there instead of flailing. A step that has no solution,
+//! or that still jumps at 1/64 (a branch switch, e.g. through the wrist singularity), stops the
+//! path instead of being executed.
 
 use crate::fixed::{Angle, ratio};
 use crate::transform::{LEN_PER_TENTH_MM, Rotation, Transform};
 use crate::{IkError, JointAngles, Kinematics, Pose};
 
-/// Default for [`LinearPath::with_max_joint_step`]: 15 deg. No joint moves this far within one
-/// step of a few millimetres unless the solution switched branch or crossed a singularity.
-pub const DEFAULT_MAX_JOINT_STEP_CENTIDEG: i32 = 1_500;
+/// Default for [`LinearPath::with_max_joint_step`]: 5 deg, a few interpolation periods of a joint
+/// at full speed; ordinary steps of a few millimetres need well under 2 deg.
+pub const DEFAULT_MAX_JOINT_STEP_CENTIDEG: i32 = 500;
+
+/// A step may be halved this many times (to 1/64) to keep joints within the per-step limit.
+const SPLIT_BITS: u32 = 6;
+
+/// Most steps in a path (2^20: 100 m at 0.1 mm per step), keeping the interpolation in `i64`.
+const MAX_STEPS: i64 = 1 << 20;
 
 /// Rotation allowed per step for each 0.1 mm of step length: 0.1 deg, i.e. a 1 mm step may turn
 /// 1 deg (the end moves about 1 mm per degree at the flange's 57 mm lever).
@@ -39,8 +48,8 @@ impl PathError {
 }
 
 /// A straight line from a start configuration to a target pose (in the model's selected tool and
-/// world frames), in equal steps; yields each step's joint angles, the last one solving the
-/// target itself.
+/// world frames), in equal steps (split near singularities); yields each step's joint angles,
+/// the last one solving the target itself.
 #[derive(Clone, Copy, Debug)]
 pub struct LinearPath {
     start: Transform,
@@ -50,8 +59,9 @@ pub struct LinearPath {
     axis: [i64; 3],
     angle: Angle,
     previous: JointAngles,
-    step: u32,
-    steps: u32,
+    /// Progress and length of the line in 1/64 steps.
+    done: i64,
+    total: i64,
     max_joint_step_centideg: i32,
     stopped: bool,
 }
@@ -85,15 +95,15 @@ impl LinearPath {
             i64::from(angle.to_centideg().abs()),
             step_tenth_mm * CENTIDEG_PER_TENTH_MM_STEP,
         );
-        let steps = by_distance.max(by_rotation).clamp(1, i64::from(u32::MAX)) as u32;
+        let steps = by_distance.max(by_rotation).clamp(1, MAX_STEPS);
         Ok(Self {
             start: from,
             target,
             axis,
             angle,
             previous: *start,
-            step: 0,
-            steps,
+            done: 0,
+            total: steps << SPLIT_BITS,
             max_joint_step_centideg: DEFAULT_MAX_JOINT_STEP_CENTIDEG,
             stopped: false,
         })
@@ -106,18 +116,17 @@ impl LinearPath {
         self
     }
 
-    /// The pose (full precision) of step `step` of `self.steps`.
-    fn waypoint(&self, step: u32) -> Transform {
-        if step >= self.steps {
+    /// The pose (full precision) at `at` 1/64 steps along the line.
+    fn waypoint(&self, at: i64) -> Transform {
+        if at >= self.total {
             return self.target;
         }
-        let (num, den) = (i64::from(step), i64::from(self.steps));
         let lerp = |i: usize| {
             let a = self.start.position.get(i).copied().unwrap_or(0);
             let b = self.target.position.get(i).copied().unwrap_or(0);
-            a + ratio((b - a) * num, den)
+            a + ratio((b - a) * at, self.total)
         };
-        let turn = Angle(ratio(i64::from(self.angle.0) * num, den) as i32);
+        let turn = Angle(ratio(i64::from(self.angle.0) * at, self.total) as i32);
         Transform {
             rotation: self
                 .start
@@ -127,24 +136,31 @@ impl LinearPath {
         }
     }
 
-    /// Solves and returns the next step's joint angles; `None` once the target was reached or
+    /// Solves and returns the next step's joint angles (a whole step, or the largest part of one
+    /// that keeps every joint within the per-step limit); `None` once the target was reached or
     /// after an error (which ends the path).
     pub fn next(&mut self, kin: &Kinematics) -> Option<Result<JointAngles, PathError>> {
-        if self.stopped || self.step >= self.steps {
+        if self.stopped || self.done >= self.total {
             return None;
         }
-        self.step += 1;
-        let result = kin
-            .inverse_transform(&self.waypoint(self.step), &self.previous)
-            .map_err(PathError::StepUnreachable)
-            .and_then(|q| match self.jumping_joint(&q) {
-                Some(joint) => Err(PathError::BranchJump { joint }),
-                None => Ok(q),
-            });
-        match result {
-            Ok(q) => self.previous = q,
-            Err(_) => self.stopped = true,
-        }
+        let mut size = 1 << SPLIT_BITS;
+        let result = loop {
+            let at = (self.done + size).min(self.total);
+            let q = match kin.inverse_transform(&self.waypoint(at), &self.previous) {
+                Ok(q) => q,
+                Err(e) => break Err(PathError::StepUnreachable(e)),
+            };
+            match self.jumping_joint(&q) {
+                None => {
+                    self.done = at;
+                    self.previous = q;
+                    break Ok(q);
+                }
+                Some(_) if size > 1 => size /= 2,
+                Some(joint) => break Err(PathError::BranchJump { joint }),
+            }
+        };
+        self.stopped = result.is_err();
         Some(result)
     }
 
@@ -155,18 +171,18 @@ impl LinearPath {
         })
     }
 
-    /// Steps in the whole path.
+    /// Whole steps in the path (more calls of [`LinearPath::next`] where steps get split).
     pub fn total_steps(&self) -> u32 {
-        self.steps
+        u32::try_from(self.total >> SPLIT_BITS).unwrap_or(u32::MAX)
     }
 
-    /// Steps not yet taken (0 once done or stopped).
+    /// Whole steps not yet taken, rounded up (0 once done or stopped).
     pub fn remaining_steps(&self) -> u32 {
         if self.stopped {
-            0
-        } else {
-            self.steps - self.step
+            return 0;
         }
+        let left = div_ceil(self.total - self.done, 1 << SPLIT_BITS);
+        u32::try_from(left).unwrap_or(u32::MAX)
     }
 
     /// The joint angles of the last step taken (the start before the first step).
@@ -275,6 +291,40 @@ mod tests {
                 (p.x - from.x).abs() <= 1 && (p.y - from.y).abs() <= 1 && (p.z - from.z).abs() <= 1
             );
         }
+    }
+
+    #[test]
+    fn leaving_the_stretched_zero_pose_slows_down_instead_of_jumping() {
+        // Straight down from the upright arm: q3 grows like the square root of the distance,
+        // so the first 2 mm step alone would bend the elbow by 16 deg.
+        let kin = Kinematics::new();
+        let zero = JointAngles::default();
+        let from = kin.forward(&zero);
+        let to = Pose {
+            z: from.z - 500,
+            ..from
+        };
+        let mut path = LinearPath::new(&kin, &zero, &to, 20).unwrap();
+        assert_eq!(path.total_steps(), 25);
+        let (mut calls, mut previous) = (0, zero);
+        while let Some(step) = path.next(&kin) {
+            let q = step.unwrap();
+            assert!(
+                q.0.iter()
+                    .zip(previous.0.iter())
+                    .all(|(a, b)| (a - b).abs() <= DEFAULT_MAX_JOINT_STEP_CENTIDEG)
+            );
+            let p = kin.forward(&q);
+            assert!(
+                (p.x - from.x).abs() <= 1 && (p.y - from.y).abs() <= 1,
+                "{p:?}"
+            );
+            assert!(p.z <= kin.forward(&previous).z, "z went up: {p:?}");
+            previous = q;
+            calls += 1;
+        }
+        assert!(calls > 25, "{calls}");
+        assert_eq!(kin.forward(&previous).z, to.z);
     }
 
     #[test]
