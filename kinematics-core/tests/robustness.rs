@@ -68,6 +68,30 @@ proptest! {
     }
 
     #[test]
+    fn targets_next_to_the_seed_are_answered_without_panic(
+        seed in prop::array::uniform6(-15_000..15_000i32),
+        delta in prop::array::uniform6(-30..30i32),
+        tool in proptest::option::of(wire_pose()),
+    ) {
+        // Exercises the seed-keeping paths (shoulder, elbow, wrist) with overflow checks on.
+        let mut kin = Kinematics::new();
+        kin.set_tool(tool);
+        let seed = JointAngles(seed);
+        let p = kin.forward(&seed);
+        let target = Pose {
+            x: p.x + delta[0],
+            y: p.y + delta[1],
+            z: p.z + delta[2],
+            rx: p.rx + delta[3],
+            ry: p.ry + delta[4],
+            rz: p.rz + delta[5],
+        };
+        if let Ok(q) = kin.inverse(&target, &seed) {
+            prop_assert!(kin.limits().contains(&q));
+        }
+    }
+
+    #[test]
     fn any_limits_are_respected(
         target in wire_pose(),
         seed in any_joints(),
