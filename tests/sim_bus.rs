@@ -106,9 +106,7 @@ fn collide_with(
         let trace = robot.bus_mut().take_trace();
         for b in trace.iter().filter(|b| b.from == station) {
             // Count from the start of a host frame: FE FE ...
-            if b.byte == 0xFE && sent.iter().all(|&x| x == 0xFE) && sent.len() < 2 {
-                sent.push(b.byte);
-            } else if sent.len() >= 2 {
+            if sent.len() >= 2 || b.byte == 0xFE {
                 sent.push(b.byte);
             } else {
                 sent.clear();

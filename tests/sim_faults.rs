@@ -49,14 +49,7 @@ fn a_servo_that_stops_answering_mid_move_is_reported_and_the_rest_carry_on() {
     let mut robot = arm();
     start_move(&mut robot);
     robot.run_for(300_000);
-    inject(
-        &mut robot,
-        3,
-        Faults {
-            no_answer: true,
-            ..Faults::default()
-        },
-    );
+    inject(&mut robot, 3, Faults::NO_ANSWER);
     let healthy = [0, 1, 3, 4, 5];
     assert!(
         robot.run_until_true(MOTION_TIMEOUT_US, |r| healthy
@@ -102,7 +95,7 @@ fn a_servo_that_stops_answering_mid_move_is_reported_and_the_rest_carry_on() {
     );
 
     // Plugged back in: the servo is seen again.
-    inject(&mut robot, 3, Faults::default());
+    inject(&mut robot, 3, Faults::NONE);
     robot.run_for(200_000);
     assert_eq!(
         ask(&mut robot, Request::AreAllServosEnabled),
@@ -113,14 +106,7 @@ fn a_servo_that_stops_answering_mid_move_is_reported_and_the_rest_carry_on() {
 #[test]
 fn a_silent_gripper_does_not_stop_the_arm() {
     let mut robot = arm();
-    inject(
-        &mut robot,
-        7,
-        Faults {
-            no_answer: true,
-            ..Faults::default()
-        },
-    );
+    inject(&mut robot, 7, Faults::NO_ANSWER);
     start_move(&mut robot);
     wait_until_stopped(&mut robot);
     assert_angles_near(robot.measured_angles(), degrees(TARGET_DEG), "arm");
@@ -131,14 +117,7 @@ fn a_silent_gripper_does_not_stop_the_arm() {
 #[test]
 fn a_stalled_joint_reports_overload_while_the_others_arrive() {
     let mut robot = arm();
-    inject(
-        &mut robot,
-        2,
-        Faults {
-            stall: true,
-            ..Faults::default()
-        },
-    );
+    inject(&mut robot, 2, Faults::STALL);
     start_move(&mut robot);
     let others = [0, 2, 3, 4, 5];
     assert!(robot.run_until_true(MOTION_TIMEOUT_US, |r| {
@@ -160,14 +139,7 @@ fn a_stalled_joint_reports_overload_while_the_others_arrive() {
 #[test]
 fn an_overheating_servo_shows_its_temperature_and_fault_bit() {
     let mut robot = arm();
-    inject(
-        &mut robot,
-        5,
-        Faults {
-            overheat: true,
-            ..Faults::default()
-        },
-    );
+    inject(&mut robot, 5, Faults::OVERHEAT);
     robot.run_for(200_000);
     let Reply::Bytes6(temps) = ask(&mut robot, Request::GetServoTemps) else {
         panic!("no temperatures");
@@ -187,14 +159,7 @@ fn an_overheating_servo_shows_its_temperature_and_fault_bit() {
 #[test]
 fn corrupt_answers_are_reported_and_the_host_is_still_served() {
     let mut robot = arm();
-    inject(
-        &mut robot,
-        6,
-        Faults {
-            bad_checksum: true,
-            ..Faults::default()
-        },
-    );
+    inject(&mut robot, 6, Faults::BAD_CHECKSUM);
     robot.run_for(200_000);
     for _ in 0..5 {
         get_angles(&mut robot);

@@ -66,6 +66,36 @@ pub struct Faults {
     pub overheat: bool,
 }
 
+impl Faults {
+    /// A healthy servo.
+    pub const NONE: Self = Self {
+        no_answer: false,
+        bad_checksum: false,
+        stall: false,
+        overheat: false,
+    };
+    /// Only [`Faults::no_answer`].
+    pub const NO_ANSWER: Self = Self {
+        no_answer: true,
+        ..Self::NONE
+    };
+    /// Only [`Faults::bad_checksum`].
+    pub const BAD_CHECKSUM: Self = Self {
+        bad_checksum: true,
+        ..Self::NONE
+    };
+    /// Only [`Faults::stall`].
+    pub const STALL: Self = Self {
+        stall: true,
+        ..Self::NONE
+    };
+    /// Only [`Faults::overheat`].
+    pub const OVERHEAT: Self = Self {
+        overheat: true,
+        ..Self::NONE
+    };
+}
+
 /// Counters of what a servo did, for tests and benchmarks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ServoStats {
@@ -135,7 +165,7 @@ impl SimServo {
             listener: PacketListener::default(),
             replies: VecDeque::new(),
             registered: None,
-            faults: Faults::default(),
+            faults: Faults::NONE,
             stats: ServoStats::default(),
         };
         servo.factory_reset(id);
@@ -928,23 +958,17 @@ mod tests {
     #[test]
     fn silent_servo_does_not_answer_but_the_others_do() {
         let mut rig = Rig::new(&[1, 2]);
-        rig.servo(0).set_faults(Faults {
-            no_answer: true,
-            ..Faults::default()
-        });
+        rig.servo(0).set_faults(Faults::NO_ANSWER);
         assert!(rig.read(1, reg::PRESENT_POSITION, 2).is_none());
         assert!(rig.read(2, reg::PRESENT_POSITION, 2).is_some());
-        rig.servo(0).set_faults(Faults::default());
+        rig.servo(0).set_faults(Faults::NONE);
         assert!(rig.read(1, reg::PRESENT_POSITION, 2).is_some(), "recovers");
     }
 
     #[test]
     fn bad_checksum_fault_corrupts_every_answer() {
         let mut rig = Rig::new(&[1]);
-        rig.servo(0).set_faults(Faults {
-            bad_checksum: true,
-            ..Faults::default()
-        });
+        rig.servo(0).set_faults(Faults::BAD_CHECKSUM);
         let trace = rig.exchange(&Instruction::Ping.to_packet(1).unwrap());
         assert!(
             trace.iter().any(|b| b.from != rig.controller),
@@ -957,10 +981,7 @@ mod tests {
     fn stalled_servo_never_arrives_and_reports_overload() {
         let mut rig = Rig::new(&[1]);
         rig.write(1, reg::TORQUE_ENABLE, &[1]);
-        rig.servo(0).set_faults(Faults {
-            stall: true,
-            ..Faults::default()
-        });
+        rig.servo(0).set_faults(Faults::STALL);
         rig.write(1, reg::MOVE_BLOCK, &move_block(0, 3000, 0));
         rig.run_for_ms(1000);
         let state = rig.read(1, reg::STATE_BLOCK, reg::STATE_BLOCK_LEN).unwrap();
@@ -981,10 +1002,7 @@ mod tests {
     #[test]
     fn overheated_servo_reports_temperature_and_fault_bit() {
         let mut rig = Rig::new(&[1]);
-        rig.servo(0).set_faults(Faults {
-            overheat: true,
-            ..Faults::default()
-        });
+        rig.servo(0).set_faults(Faults::OVERHEAT);
         let state = rig.read(1, reg::STATE_BLOCK, reg::STATE_BLOCK_LEN).unwrap();
         assert_eq!(state.code(), fault::OVERHEAT);
         assert_eq!(state.params()[7], OVERHEAT_C);
