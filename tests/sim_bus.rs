@@ -3,7 +3,7 @@
 
 mod sim_support;
 
-use open_mycobot::sim::{HostLink, RobotConfig, StationId, VirtualRobot};
+use open_mycobot::sim::{BusByte, HostLink, RobotConfig, StationId, VirtualRobot};
 use protocol_core::command::{JointId, Reply, Request};
 use protocol_core::timing::HOST_REPLY_DEADLINE_US;
 use protocol_core::units::Centideg;
@@ -238,4 +238,76 @@ fn an_incremental_jog_whose_reply_collides_moves_once_and_is_answered() {
     );
     let reply = reply.expect("the jog's reply was lost: pymycobot would resend it and jog twice");
     assert_eq!(reply.cmd(), jog.to_frame().cmd());
+}
+
+/// Quiet time before each burst on the bus that `pick` selects (given the burst's first two
+/// bytes), in us. A burst starts when a station starts sending after the wire was silent.
+fn quiet_before(
+    trace: &[BusByte],
+    mut pick: impl FnMut(&BusByte, Option<&BusByte>) -> bool,
+) -> Vec<u64> {
+    let mut quiet = Vec::new();
+    let mut prev_end = u64::MAX;
+    for (i, b) in trace.iter().enumerate() {
+        let follows_another = i > 0 && trace.get(i - 1).is_some_and(|p| p.from != b.from);
+        let starts_burst = prev_end != u64::MAX
+            && b.start_ns >= prev_end
+            && (b.start_ns > prev_end || follows_another);
+        if starts_burst && pick(b, trace.get(i + 1)) {
+            quiet.push((b.start_ns - prev_end) / 1_000);
+        }
+        prev_end = if prev_end == u64::MAX {
+            b.end_ns
+        } else {
+            prev_end.max(b.end_ns)
+        };
+    }
+    quiet
+}
+
+#[test]
+fn every_station_keeps_the_bus_timing_rules_during_a_busy_session() {
+    use protocol_core::timing::{
+        ATOM_TRANSACTION_GAP_US, BUS_QUIET_BEFORE_SEND_US, SERVO_TURNAROUND_MAX_US,
+    };
+    let mut robot = arm();
+    robot.bus_mut().set_tracing(true);
+    ack(
+        &mut robot,
+        Request::SendAngles {
+            angles: degrees([60.0; 6]),
+            speed: speed(15),
+        },
+    );
+    let mut trace = Vec::new();
+    for k in 0..40 {
+        get_angles(&mut robot);
+        robot.run_for(2_000 + k * 137);
+        trace.extend(robot.bus_mut().take_trace());
+    }
+    let basic = robot.basic_station().expect("basic");
+    let atom = robot.atom_station();
+    // Firmware sees time in whole microseconds: allow 1 us of rounding.
+    let atom_gaps = quiet_before(&trace, |b, next| {
+        b.from == atom && b.byte == 0xFF && next.is_some_and(|n| n.byte == 0xFF)
+    });
+    assert!(atom_gaps.len() > 100, "the Atom polls the servos");
+    let shortest = atom_gaps.iter().min().copied().unwrap_or(0);
+    assert!(
+        shortest + 1 >= ATOM_TRANSACTION_GAP_US,
+        "Atom gap {shortest} us"
+    );
+    let basic_gaps = quiet_before(&trace, |b, _| b.from == basic);
+    assert!(basic_gaps.len() >= 40, "the Basic forwards every request");
+    let shortest = basic_gaps.iter().min().copied().unwrap_or(0);
+    assert!(
+        shortest + 1 >= BUS_QUIET_BEFORE_SEND_US,
+        "Basic quiet {shortest} us"
+    );
+    let servo_turnarounds = quiet_before(&trace, |b, _| b.from != atom && b.from != basic);
+    let longest = servo_turnarounds.iter().max().copied().unwrap_or(0);
+    assert!(
+        longest <= SERVO_TURNAROUND_MAX_US,
+        "servo turnaround {longest} us"
+    );
 }
