@@ -38,10 +38,10 @@
 //!   after, which is the wire's own rounding).
 //! * IK of the exact FK, answers rounded to 0.01 deg: 100 % within 0.1 mm / 0.05 deg (worst
 //!   0.050 mm, 0.022 deg), singular configurations included.
-//! * IK of the FK rounded to the wire (what `get_coords` then `send_coords` does): 99.98 %
-//!   (and where the seed already reaches the pose within 0.05 mm, the joints stay put);
-//!   the rest lie next to a singularity or a limit, where the rounding alone makes the pose
-//!   unreachable or moves its solution past the limit.
+//! * IK of the FK rounded to the wire (what `get_coords` then `send_coords` does), seeded with
+//!   the configuration read: 100 % within 0.1 mm / 0.05 deg (worst 0.086 mm, the rounding
+//!   itself). Next to singularities the rounded pose can be unreachable or far in joint space;
+//!   a seed that is already at the target to within the wire's rounding is returned as is.
 //!
 //! Host cost (x86-64, release): FK about 0.5 us and 2 300 instructions, IK (all branches and the
 //! selection) about 2 us and 9 500 instructions per call:
@@ -106,6 +106,19 @@ impl IkError {
     /// The 0x07 error code for "IK has no solution".
     pub const PROTOCOL_CODE: u8 = 32;
 }
+
+/// A solution farther than this (0.5 deg) from the seed in some joint makes
+/// [`Kinematics::inverse`] check whether the seed already is at the target.
+const SEED_CHECK_CENTIDEG: i32 = 50;
+
+/// Position distance (0.09 mm) within which a pose counts as the target: the wire's 0.1 mm
+/// rounding of three coordinates moves a pose by up to 0.087 mm.
+const ROUNDING_POSITION: transform::Len = 9 * transform::LEN_PER_TENTH_MM / 10;
+
+/// Largest rotation-matrix entry difference (Q30, 1.75e-4 = 0.01 deg) within which an
+/// orientation counts as the target's: the wire's 0.01 deg rounding of three angles turns it by
+/// up to 0.0087 deg.
+const ROUNDING_ROTATION_Q30: i64 = 187_904;
 
 /// The robot model: link geometry, joint limits, and the tool and world frames.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -180,7 +193,9 @@ impl Kinematics {
     /// The joint angles that put the end (per the selected frames) at `target`: of all branches
     /// within the limits (each joint wrapped by +-360 deg), the best fit (exact, then clamped to
     /// reach by up to 0.2 mm, then traded at the wrist singularity), and of those the one nearest
-    /// `seed` (squared distance in joint space).
+    /// `seed` (squared distance in joint space). If that answer is far from the seed (or there is
+    /// none) but the seed itself is within the wire's rounding of the target (0.09 mm, 0.01 deg),
+    /// the seed is the answer: resending the coordinates just read never moves the arm.
     pub fn inverse(&self, target: &Pose, seed: &JointAngles) -> Result<JointAngles, IkError> {
         self.inverse_transform(&Transform::from_pose(target), seed)
     }
@@ -192,15 +207,45 @@ impl Kinematics {
         target: &Transform,
         seed: &JointAngles,
     ) -> Result<JointAngles, IkError> {
-        let branches = ik::solve(&self.links, &self.flange_of(target), &self.seed_theta(seed))?;
+        let branches = ik::solve(&self.links, &self.flange_of(target), &self.seed_theta(seed));
         // The best fit first (exact, clamped, near-singular), then the nearest to the seed.
-        branches
-            .iter()
-            .flatten()
-            .filter_map(|b| Some((self.in_limits_near(&b.theta, seed)?, b.fit)))
-            .min_by_key(|((_, distance), fit)| (*fit, *distance))
-            .map(|((q, _), _)| q)
-            .ok_or(IkError::OutsideLimits)
+        let best = branches.and_then(|branches| {
+            branches
+                .iter()
+                .flatten()
+                .filter_map(|b| Some((self.in_limits_near(&b.theta, seed)?, b.fit)))
+                .min_by_key(|((_, distance), fit)| (*fit, *distance))
+                .map(|((q, _), _)| q)
+                .ok_or(IkError::OutsideLimits)
+        });
+        // Next to a singularity the wire's rounding can move the solution far from the seed, or
+        // out of reach, although the seed itself is at the target to within that rounding (a
+        // user resending the coordinates just read): then the arm stays where it is.
+        let far_from_seed = best.map_or(true, |q| {
+            q.0.iter()
+                .zip(seed.0.iter())
+                .any(|(a, b)| (a - b).abs() > SEED_CHECK_CENTIDEG)
+        });
+        if far_from_seed && self.limits.contains(seed) && self.reaches(seed, target) {
+            return Ok(*seed);
+        }
+        best
+    }
+
+    /// Whether the end at `q` is within the wire's rounding of `target`.
+    fn reaches(&self, q: &JointAngles, target: &Transform) -> bool {
+        let at = self.forward_transform(q);
+        let [dx, dy, dz] = core::array::from_fn(|i| {
+            at.position.get(i).copied().unwrap_or(0) - target.position.get(i).copied().unwrap_or(0)
+        });
+        let turned = (0..3)
+            .flat_map(|r| (0..3).map(move |c| (r, c)))
+            .map(|(r, c)| (at.rotation.at(r, c) - target.rotation.at(r, c)).abs())
+            .max()
+            .unwrap_or(0);
+        [dx, dy, dz].iter().all(|d| d.abs() <= ROUNDING_POSITION)
+            && dx * dx + dy * dy + dz * dz <= ROUNDING_POSITION * ROUNDING_POSITION
+            && turned <= ROUNDING_ROTATION_Q30
     }
 
     /// Every branch for `target` as joint angles wrapped into the limits near `seed` (`None` for

@@ -258,7 +258,7 @@ fn inverse_of_exact_forward_reaches_the_target() {
 
 /// What a user does: read the coordinates (rounded to 0.1 mm / 0.01 deg) and send them back.
 /// Near a singularity the rounding itself can make the pose unreachable or move the solution
-/// past a limit, so only configurations clear of both must succeed; the rest is reported.
+/// past a limit; the seed (the configuration read) must still be found.
 #[test]
 fn inverse_of_wire_pose_round_trips() {
     let kin = Kinematics::new();
@@ -277,6 +277,10 @@ fn inverse_of_wire_pose_round_trips() {
         }
         if !matches!(reached, Ok((mm, deg)) if mm <= 0.1 && deg <= 0.05) {
             failed += 1;
+            println!(
+                "  failed: q {q:?} target {target:?} -> {reached:?}, singularity margin {:.2} deg",
+                singularity_margin_deg(&q)
+            );
             if singularity_margin_deg(&q) > 5.0 && inside_limits_by(&q, kin.limits(), 100) {
                 clear_failures.push((q, target, reached));
             }
@@ -287,6 +291,7 @@ fn inverse_of_wire_pose_round_trips() {
         100.0 - failed as f64 * 100.0 / SAMPLES as f64
     );
     assert!(clear_failures.is_empty(), "{clear_failures:?}");
+    assert!(failed * 10_000 <= SAMPLES, "{failed} failures");
 }
 
 #[test]
@@ -504,6 +509,10 @@ fn resending_the_read_coordinates_keeps_the_joints() {
         [-2500, 3000, -6000, 3000, 0, 0],
         [0, 1000, -2000, 1000, 0, 0],
         [1234, 1000, -500, 1000, 3000, -2000],
+        // Next to the wrist singularity and the stretched elbow: the rounded pose itself is
+        // out of reach.
+        [5434, 7768, 330, 7340, 9111, -15960],
+        [12208, 8320, 1122, -8970, -9014, 3089],
     ] {
         let q = JointAngles(q);
         let sol = kin.inverse(&kin.forward(&q), &q).unwrap();
