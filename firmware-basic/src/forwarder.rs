@@ -2,14 +2,17 @@
 //! returns the one reply that answers it.
 //!
 //! A request is transmitted only into a quiet wire ([`timing::BUS_QUIET_BEFORE_SEND_US`]),
-//! its echo is read back and compared when the wiring echoes, a collision (echo differs, or a
-//! foreign byte while transmitting) is retransmitted after a growing back-off, at most
-//! [`BasicConfig::max_send_attempts`] times. An echo that is missing or cut short proves
-//! nothing (the frame may have gone out and only our receiver missed it), so it is
-//! retransmitted only if repeating the request is harmless. Then only a complete `FE FE` frame with the
-//! request's CMD byte counts as the reply; servo packets, other frames and late duplicates are
-//! dropped, and a request that gets no reply is given up after its deadline so the next one can
-//! go. Requests wait in a bounded queue meanwhile.
+//! early enough in the Atom's gap between servo transactions that the Atom hears it before it
+//! would start its next one ([`LATEST_START_IN_GAP_US`]), or once the gap has visibly ended
+//! with nobody talking ([`ATOM_START_SEEN_US`]). Its echo is read back and compared when the
+//! wiring echoes; a collision (echo differs, or a foreign byte while transmitting) is
+//! retransmitted after a growing back-off, at most [`BasicConfig::max_send_attempts`] times. An
+//! echo that is missing or cut short proves nothing (the frame may have gone out and only our
+//! receiver missed it), so it is retransmitted only if repeating the request is harmless.
+//! Then only a complete `FE FE` frame with the request's CMD byte counts as the reply; servo
+//! packets, other frames and late duplicates are dropped, and a request that gets no reply is
+//! given up after its deadline so the next one can go. Requests wait in a bounded queue
+//! meanwhile.
 //!
 //! A reply garbled on the wire (a frame header `FE FE` heard, but no valid frame) is lost for
 //! good: the Atom does not know. The Basic then sends the request again at once, instead of
@@ -38,6 +41,18 @@ pub const MAX_QUEUED_US: u64 = timing::HOST_REPLY_DEADLINE_US;
 pub const ECHO_GRACE_US: u64 = 20;
 /// Longest back-off after a collision, in microseconds.
 pub const MAX_BACKOFF_US: u64 = 2_000;
+/// How late a station may act on what the wire did (its poll period, receiver latency), in
+/// microseconds.
+const REACTION_US: u64 = 10;
+/// Quiet time from which the Basic no longer starts a frame: the Atom may start its next
+/// transaction at [`timing::ATOM_TRANSACTION_GAP_US`] of quiet, and must hear our first byte
+/// before that (one byte time, and its reaction time) to hold back.
+pub const LATEST_START_IN_GAP_US: u64 =
+    timing::ATOM_TRANSACTION_GAP_US - timing::wire_time_us(1, timing::BUS_BAUD) - REACTION_US;
+/// Quiet time after which the Atom has visibly not started a transaction at the end of its
+/// gap (its first byte would have been heard by now), so the wire is free again.
+pub const ATOM_START_SEEN_US: u64 =
+    timing::ATOM_TRANSACTION_GAP_US + timing::wire_time_us(2, timing::BUS_BAUD) + REACTION_US;
 
 /// True if sending `request` to the Atom twice does no harm: everything but the incremental
 /// jogs (0x33 jog increment angle, 0x34 jog increment coord / jog stop), which would move the
@@ -396,7 +411,12 @@ impl Forwarder {
         let Stage::WaitQuiet { not_before_us } = flight.stage else {
             return;
         };
-        if now_us < not_before_us || quiet_us < timing::BUS_QUIET_BEFORE_SEND_US || !bus.tx_idle() {
+        // Carrier sense sees a byte only once it is complete: starting late in the Atom's gap,
+        // both stations would start before hearing each other.
+        let quiet_enough = (timing::BUS_QUIET_BEFORE_SEND_US..LATEST_START_IN_GAP_US)
+            .contains(&quiet_us)
+            || quiet_us >= ATOM_START_SEEN_US;
+        if now_us < not_before_us || !quiet_enough || !bus.tx_idle() {
             return;
         }
         // The wire is quiet: a partial frame in the decoder can no longer complete, and must not

@@ -400,3 +400,29 @@ fn fifty_pipelined_requests_get_fifty_replies() {
     assert_eq!(rig.atom_got.len(), 50);
     assert_eq!(rig.basic.status().last_error, None);
 }
+
+#[test]
+fn the_basic_never_starts_late_in_the_atoms_gap() {
+    use firmware_basic::forwarder::{ATOM_START_SEEN_US, LATEST_START_IN_GAP_US};
+    // Whenever the host request completes, relative to the end of the Atom's last servo
+    // packet, the Basic starts either early in the gap (the Atom hears it before its gap of
+    // 100 us is over) or once the gap is visibly over - never in between, where both
+    // stations would start before hearing each other.
+    for phase_us in (0..200).step_by(7) {
+        let mut rig = Rig::quiet(true);
+        let host_end_ns = 5 * common::HOST_BYTE_NS;
+        let packet_end_ns = host_end_ns - phase_us * 1_000;
+        rig.wire().inject(
+            packet_end_ns - SERVO_PACKET.len() as u64 * BUS_BYTE_NS,
+            &SERVO_PACKET,
+        );
+        rig.host.send(&frame(GET_ANGLES, &[]));
+        rig.run_us(3_000);
+        let quiet_us = (rig.wire().basic_sent[0].0 - packet_end_ns) / 1_000;
+        assert!(
+            (60..LATEST_START_IN_GAP_US).contains(&quiet_us) || quiet_us >= ATOM_START_SEEN_US,
+            "request ready {phase_us} us into the gap: sent after {quiet_us} us of quiet"
+        );
+        assert_eq!(rig.host.received(), angles_reply());
+    }
+}
