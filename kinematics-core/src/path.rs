@@ -27,8 +27,8 @@ const CENTIDEG_PER_TENTH_MM_STEP: i64 = 10;
 /// Why a linear move stops (protocol 0x07 codes in [`PathError::protocol_code`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PathError {
-    /// A step has solutions, but in all of them some joint jumps by more than the per-step limit
-    /// from the previous step (a branch switch or a singularity on the line).
+    /// The nearest solution of a step, even split to 1/64, moves a joint by more than the
+    /// per-step limit from the previous step (a branch switch, or a singularity on the line).
     BranchJump {
         /// 0-based joint that would jump.
         joint: usize,
@@ -68,7 +68,7 @@ pub struct LinearPath {
 
 impl LinearPath {
     /// A path from the end pose at `start` to `target` in steps of at most `step_tenth_mm` of
-    /// travel (and 0.1 deg of rotation per 0.1 mm, see the module doc), at least one step.
+    /// travel and at most 0.1 deg of rotation per 0.1 mm of step length; at least one step.
     /// Fails with the target's [`IkError`] (protocol error 32) if the target has no solution.
     pub fn new(
         kin: &Kinematics,
