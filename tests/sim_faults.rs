@@ -87,6 +87,7 @@ fn a_servo_that_stops_answering_mid_move_is_reported_and_the_rest_carry_on() {
         [status[0], status[1], status[3], status[4], status[5]],
         [0; 5]
     );
+    assert_ne!(status[2], 0, "get_servo_status calls a silent servo healthy");
     let errors = servo_errors(&mut robot);
     assert_eq!(errors[2], ServoErrorCode::NoAnswer.code(), "{errors:?}");
     assert_eq!(
