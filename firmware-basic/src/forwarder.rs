@@ -54,6 +54,15 @@ pub const LATEST_START_IN_GAP_US: u64 =
 pub const ATOM_START_SEEN_US: u64 =
     timing::ATOM_TRANSACTION_GAP_US + timing::wire_time_us(2, timing::BUS_BAUD) + REACTION_US;
 
+/// True if the Basic may start transmitting after the wire has been quiet for `quiet_us`:
+/// past any servo's turnaround, and either early in the Atom's gap or once the gap has
+/// visibly passed. Carrier sense sees a byte only once it is complete, so starting late in
+/// the gap, both stations would start before hearing each other.
+pub fn may_start_after_quiet(quiet_us: u64) -> bool {
+    (timing::BUS_QUIET_BEFORE_SEND_US..LATEST_START_IN_GAP_US).contains(&quiet_us)
+        || quiet_us >= ATOM_START_SEEN_US
+}
+
 /// True if sending `request` to the Atom twice does no harm: everything but the incremental
 /// jogs (0x33 jog increment angle, 0x34 jog increment coord / jog stop), which would move the
 /// arm twice as far.
@@ -411,12 +420,7 @@ impl Forwarder {
         let Stage::WaitQuiet { not_before_us } = flight.stage else {
             return;
         };
-        // Carrier sense sees a byte only once it is complete: starting late in the Atom's gap,
-        // both stations would start before hearing each other.
-        let quiet_enough = (timing::BUS_QUIET_BEFORE_SEND_US..LATEST_START_IN_GAP_US)
-            .contains(&quiet_us)
-            || quiet_us >= ATOM_START_SEEN_US;
-        if now_us < not_before_us || !quiet_enough || !bus.tx_idle() {
+        if now_us < not_before_us || !may_start_after_quiet(quiet_us) || !bus.tx_idle() {
             return;
         }
         // The wire is quiet: a partial frame in the decoder can no longer complete, and must not

@@ -7,14 +7,14 @@
 //! `FE FE 02 C3 FA` (get mode: answered `01`). Host bytes that might be the start of one of
 //! them are held back until they are known not to be (or the host goes quiet for
 //! [`timing::HOST_FRAME_GAP_US`]), so these frames never reach the bus. Everything else is
-//! copied: host bytes go onto the bus only into a quiet wire, and every bus byte goes to the
+//! copied: host bytes go onto the bus only into a free wire (as framed requests do), and every bus byte goes to the
 //! host except the Basic's own echo.
 
 use heapless::{Deque, Vec};
 use protocol_core::BytePort;
 use protocol_core::timing;
 
-use crate::forwarder::ECHO_GRACE_US;
+use crate::forwarder::{ECHO_GRACE_US, may_start_after_quiet};
 
 /// A host frame the Basic still answers in transparent mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -136,8 +136,8 @@ impl Transparent {
         self.echoed = 0;
     }
 
-    /// Writes queued host bytes onto the bus when the wire has been quiet for
-    /// [`timing::BUS_QUIET_BEFORE_SEND_US`]. `echo` is whether the wiring echoes, if known.
+    /// Writes queued host bytes onto the bus when the wire is free
+    /// ([`may_start_after_quiet`]). `echo` is whether the wiring echoes, if known.
     /// Returns `Some(false)` when a write came back silent (no echo on this wiring).
     pub(crate) fn poll<B: BytePort>(
         &mut self,
@@ -158,10 +158,7 @@ impl Transparent {
             }
             self.release_echo(&mut emit);
         }
-        if self.to_bus.is_empty()
-            || !self.sent.is_empty()
-            || bus_quiet_us < timing::BUS_QUIET_BEFORE_SEND_US
-        {
+        if self.to_bus.is_empty() || !self.sent.is_empty() || !may_start_after_quiet(bus_quiet_us) {
             return learned;
         }
         let mut chunk: Vec<u8, BUS_WRITE_CHUNK> = Vec::new();
