@@ -10,7 +10,7 @@ const LEN_PER_UM: i64 = LEN_PER_TENTH_MM / 100;
 
 /// Link lengths of a six-axis arm of the Universal-Robots type (joints 2, 3, 4 parallel, offset
 /// wrist): DH alpha = (+90, 0, 0, +90, -90, 0) deg, and every d and a not named here is zero.
-/// Lengths in micrometres, signs as in the DH table.
+/// Lengths in micrometres (each within +-1 m), signs as in the DH table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ArmGeometry {
     /// d1: base to shoulder height, um.

@@ -11,7 +11,7 @@
     clippy::needless_range_loop
 )]
 
-use kinematics_core::{IkError, JointAngles, JointLimits, Kinematics, Pose};
+use kinematics_core::{ArmGeometry, IkError, JointAngles, JointLimits, Kinematics, Pose};
 
 #[cfg(debug_assertions)]
 const SAMPLES: usize = 4_000;
@@ -522,6 +522,36 @@ fn resending_the_read_coordinates_keeps_the_joints() {
                 .zip(q.0.iter())
                 .all(|(a, b)| (a - b).abs() <= 5),
             "{q:?} -> {sol:?}"
+        );
+    }
+}
+
+/// A calibrated geometry (here the URDF's link lengths) replaces the vendor table everywhere.
+#[test]
+fn a_calibrated_geometry_solves_too() {
+    let urdf = ArmGeometry {
+        d1_um: 131_560,
+        d4_um: 64_620,
+        d5_um: 73_180,
+        ..ArmGeometry::MYCOBOT_280
+    };
+    let kin = Kinematics::with_geometry(&urdf);
+    assert_ne!(
+        kin.forward(&JointAngles::default()),
+        Kinematics::new().forward(&JointAngles::default())
+    );
+    let mut rng = Rng(0xC0FF_EE00_1234_5678);
+    for _ in 0..SAMPLES / 20 {
+        let q = rng.joints(kin.limits());
+        let target = kin.forward_transform(&q);
+        let sol = kin.inverse_transform(&target, &q).unwrap();
+        let (mm, deg) = distance(
+            &transform_f64(&kin.forward_transform(&sol)),
+            &transform_f64(&target),
+        );
+        assert!(
+            mm <= 0.1 && deg <= 0.05,
+            "{q:?} -> {sol:?}: {mm} mm {deg} deg"
         );
     }
 }
