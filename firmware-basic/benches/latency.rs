@@ -129,10 +129,11 @@ fn main() {
     }
 
     println!(
-        "With the Atom polling servos (29-byte transactions, {} us gaps): the Basic waits for a \
-         gap of {} us before it sends",
+        "With the Atom polling servos (29-byte transactions, {} us gaps): the Basic waits for \
+         a free slot early in a gap ({}..{} us of quiet)",
         timing::ATOM_TRANSACTION_GAP_US,
-        timing::BUS_QUIET_BEFORE_SEND_US
+        timing::BUS_QUIET_BEFORE_SEND_US,
+        firmware_basic::forwarder::LATEST_START_IN_GAP_US
     );
     for echo in [true, false] {
         let (name, request) = &requests[0];
