@@ -59,30 +59,24 @@ fn works_whether_or_not_the_boards_hear_their_own_echo() {
 }
 
 /// Sends `request`, throws `noise` onto the bus `delay_us` later, and returns every frame the
-/// host got: up to the first one (within pymycobot's reply deadline) and 30 ms after it.
+/// host got: the first one (within pymycobot's reply deadline) and any within 30 ms after it.
 fn exchange_with_noise(
     robot: &mut VirtualRobot,
     request: &Frame,
     delay_us: u64,
     noise: &[u8],
 ) -> Vec<Frame> {
-    let deadline = robot.now_us() + HOST_REPLY_DEADLINE_US;
     robot.host_write(&request.to_bytes());
     robot.run_for(delay_us);
     robot.inject_bus_noise(noise);
-    let mut decoder = FrameDecoder::new();
-    let mut frames = Vec::new();
-    let mut bytes = Vec::new();
-    while frames.is_empty() && robot.now_us() < deadline {
-        robot.run_for(100);
-        bytes.clear();
-        robot.host_read(&mut bytes);
-        decoder.feed(&bytes, |f| frames.push(f));
-    }
+    let Some(first) = robot.await_frame(HostLink::Basic, HOST_REPLY_DEADLINE_US - delay_us) else {
+        return Vec::new();
+    };
+    let mut frames = vec![first];
     robot.run_for(30_000);
-    bytes.clear();
+    let mut bytes = Vec::new();
     robot.host_read(&mut bytes);
-    decoder.feed(&bytes, |f| frames.push(f));
+    FrameDecoder::new().feed(&bytes, |f| frames.push(f));
     frames
 }
 
@@ -116,16 +110,7 @@ fn collide_with(
     let collisions_before = robot.bus().collisions();
     robot.inject_bus_noise(&[0x00, 0xFE, 0x55]);
     robot.bus_mut().set_tracing(false);
-    let mut decoder = FrameDecoder::new();
-    let mut found = None;
-    while found.is_none() && robot.now_us() < deadline {
-        robot.run_for(100);
-        let mut bytes = Vec::new();
-        robot.host_read(&mut bytes);
-        decoder.feed(&bytes, |f| {
-            found.get_or_insert(f);
-        });
-    }
+    let found = robot.await_frame(HostLink::Basic, deadline.saturating_sub(robot.now_us()));
     assert!(
         robot.bus().collisions() > collisions_before,
         "the noise missed"

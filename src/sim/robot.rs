@@ -371,21 +371,27 @@ impl VirtualRobot {
     /// Like [`VirtualRobot::transact`] on any host link.
     pub fn transact_on(&mut self, link: HostLink, request: &Frame) -> Option<Frame> {
         self.link_write(link, &request.to_bytes());
-        let deadline = self.now_us() + HOST_REPLY_DEADLINE_US;
+        self.await_frame(link, HOST_REPLY_DEADLINE_US)
+    }
+
+    /// Runs until a complete host frame has arrived on `link` or `timeout_us` has passed, and
+    /// returns it. Bytes before the frame are skipped; bytes after it stay unread (for
+    /// [`VirtualRobot::link_read`] or the next call), so a duplicate reply cannot hide.
+    pub fn await_frame(&mut self, link: HostLink, timeout_us: u64) -> Option<Frame> {
+        let deadline = self.now_us().saturating_add(timeout_us);
         let mut decoder = FrameDecoder::new();
-        let mut bytes = Vec::new();
-        while self.now_us() < deadline {
-            // A byte at 115200 takes 87 us: look at what came back once per byte time.
-            self.run_for(87);
-            bytes.clear();
-            self.link_read(link, &mut bytes);
-            for &b in &bytes {
-                if let Some(frame) = decoder.push(b) {
+        loop {
+            while let Some(byte) = self.usb_mut(link).and_then(|usb| usb.to_host.receive()) {
+                if let Some(frame) = decoder.push(byte) {
                     return Some(frame);
                 }
             }
+            if self.now_us() >= deadline {
+                return None;
+            }
+            // A byte at 115200 takes 87 us: look at what came back once per byte time.
+            self.run_until(deadline.min(self.now_us() + 87));
         }
-        None
     }
 
     /// Sends `request` on the Basic's USB port like pymycobot does (one try) and returns the
