@@ -548,6 +548,24 @@ mod tests {
     }
 
     #[test]
+    fn await_frame_leaves_what_follows_the_frame_unread() {
+        let mut robot = VirtualRobot::new(RobotConfig::default());
+        robot.run_for(10_000);
+        let request = Request::GetBasicVersion.to_frame();
+        let mut twice = request.to_bytes().to_vec();
+        twice.extend_from_slice(&request.to_bytes());
+        robot.host_write(&twice);
+        let first = robot.await_frame(HostLink::Basic, HOST_REPLY_DEADLINE_US);
+        assert_eq!(first.map(|f| f.cmd()), Some(request.cmd()));
+        robot.run_for(50_000);
+        let mut rest = Vec::new();
+        robot.host_read(&mut rest);
+        let mut frames = Vec::new();
+        FrameDecoder::new().feed(&rest, |f| frames.push(f));
+        assert_eq!(frames.len(), 1, "the second reply is intact: {rest:02x?}");
+    }
+
+    #[test]
     fn without_a_basic_the_basic_port_is_dead() {
         let mut robot = VirtualRobot::new(RobotConfig {
             with_basic: false,
