@@ -181,17 +181,20 @@ pub(crate) fn solve(
     // while the pose hardly changes: keep the seed's phi if a wrist point within SEED_SLACK
     // of the target's allows it.
     let h2 = r2 - d4 * d4;
-    let h2_slack = 2 * sqrt(r2) * SEED_SLACK;
     let phi = atan2(sqrt(h2), d4);
     let seed_phi = seed_theta1.sub(psi).sub(Angle::QUARTER);
     let keep_seed = |seed_side: Angle| {
         // The slack allows a few degrees at most: skip the bounds for seeds farther off.
-        near(seed_side, phi)
-            && (atan2(sqrt(h2 - h2_slack), d4).0..=atan2(sqrt(h2 + h2_slack), d4).0)
+        near(seed_side, phi) && {
+            let h2_slack = 2 * sqrt(r2) * SEED_SLACK;
+            (atan2(sqrt(h2 - h2_slack), d4).0..=atan2(sqrt(h2 + h2_slack), d4).0)
                 .contains(&seed_side.0)
+        }
     };
 
     let (s_len, d_len) = (a2.abs() + a3.abs(), (a2.abs() - a3.abs()).abs());
+    // |e|^2 the seed's elbow angle reaches.
+    let seed_l2 = a2 * a2 + a3 * a3 + 2 * a2 * mul(a3, seed_theta3.sin_cos().1);
     let cos_sign = if (a2 < 0) == (a3 < 0) { 1 } else { -1 };
     let mut out: Branches = [None; MAX_BRANCHES];
     let mut degenerate = false;
@@ -269,16 +272,11 @@ pub(crate) fn solve(
             let toward_e = atan2(ey, ex);
             // Next to the stretched elbow t3 is ill-conditioned too: keep the seed's t3 if it
             // reaches within SEED_SLACK of |e| and lies on this branch's side.
-            let l2_slack = 2 * sqrt(l2) * SEED_SLACK;
-            let seed_l2 = {
-                let (_, c3) = seed_theta3.sin_cos();
-                a2 * a2 + a3 * a3 + 2 * a2 * mul(a3, c3)
-            };
             for (elbow, sign3) in [1i64, -1].into_iter().enumerate() {
                 let mut t3 = atan2(sign3 * sin3, cos3);
                 if near(seed_theta3, t3)
                     && (seed_theta3.0 >= 0) == (t3.0 >= 0)
-                    && (seed_l2 - l2).abs() <= l2_slack
+                    && (seed_l2 - l2).abs() <= 2 * sqrt(l2) * SEED_SLACK
                 {
                     t3 = seed_theta3;
                 }

@@ -44,7 +44,7 @@
 //!   a seed that is already at the target to within the wire's rounding is returned as is.
 //!
 //! Host cost (x86-64, release): FK about 0.5 us and 2 300 instructions, IK (all branches and the
-//! selection) about 2 us and 9 500 instructions per call:
+//! selection) about 2 us and 9 400 instructions per call:
 //! * `cargo bench -p kinematics-core` (criterion: FK, IK, a 27-step linear path);
 //! * `kinematics-core/benches/callgrind.sh` (instructions per call, via valgrind's callgrind:
 //!   the difference between runs of `examples/ik_count.rs` with N and with 0 calls);
