@@ -14,8 +14,11 @@ import argparse
 import statistics
 import sys
 import time
+import warnings
 
 from pymycobot import MyCobot280, MyCobot280Socket
+
+warnings.filterwarnings("ignore", category=DeprecationWarning)  # pymycobot's locale call
 
 LIMITS = [168, 140, 150, 150, 160, 180]
 TARGET_RATE = 300.0
