@@ -56,6 +56,9 @@ const STATE_READ_LEN: u8 = reg::PRESENT_CURRENT + 2 - reg::TORQUE_ENABLE;
 /// left alone after this many).
 const MAX_REPAIRS: u8 = 3;
 
+/// Speed at which a servo switched on outside its joint limits is pulled back inside: 10 %.
+const HOLD_SPEED_PERCENT: u8 = 10;
+
 /// How long a fresh goal counts as "moving" before the servo's own moving flag is read back:
 /// several refresh rounds (a round takes about 3 ms).
 const GOAL_CONFIRM_US: u64 = 30_000;
@@ -589,8 +592,19 @@ impl Atom {
         let Some(&id) = self.config.servo_ids.get(index) else {
             return false;
         };
-        let queued = Op::write(id, reg::TORQUE_ENABLE, &[u8::from(on)])
-            .is_some_and(|op| self.queue_op(op, Then::Nothing));
+        if on && !self.powered {
+            return false;
+        }
+        let queued = if on {
+            match self.torque_on_op(index, id) {
+                Some(op) => self.queue_op(op, Then::Nothing),
+                // Position not read yet: `verify` switches it on after the first state read.
+                None => true,
+            }
+        } else {
+            Op::write(id, reg::TORQUE_ENABLE, &[0])
+                .is_some_and(|op| self.queue_op(op, Then::Nothing))
+        };
         if queued && let Some(h) = self.health.get_mut(index) {
             h.torque_on = on;
             if let Some(r) = self.repairs.get_mut(index) {
@@ -598,6 +612,36 @@ impl Atom {
             }
         }
         queued
+    }
+
+    /// The write that switches servo `index` on holding its present position (pulled into
+    /// the joint limits if the arm was moved beyond them by hand, at [`HOLD_SPEED_PERCENT`]);
+    /// `None` until the servo's position has been read.
+    fn torque_on_op(&self, index: usize, id: u8) -> Option<Op> {
+        let h = self.health.get(index)?;
+        if !h.answering {
+            return None;
+        }
+        let position = match self.limits.get(index) {
+            Some(limit) => {
+                let angle = self.config.steps_to_angle(index, h.position);
+                let inside = Centideg(angle.0.clamp(limit.min.0, limit.max.0));
+                self.config.angle_to_steps(index, inside)
+            }
+            None => h.position,
+        };
+        let mut one: GoalSet = [None; SERVOS];
+        if let Some(slot) = one.get_mut(index) {
+            *slot = Some(Goal {
+                position,
+                speed_steps_per_s: motion::joint_speed_steps(&self.config, HOLD_SPEED_PERCENT)
+                    as u16,
+                accel: motion::joint_accel_register(&self.config),
+            });
+        }
+        safety::check(&self.config, &self.limits, self.powered, one)
+            .ok()?
+            .torque_on_write(index, id)
     }
 
     // ----- motion -------------------------------------------------------------------------
@@ -713,7 +757,13 @@ impl Atom {
         let speed = motion::joint_speed_steps(&self.config, 100) as u16;
         let mut goals: GoalSet = [None; SERVOS];
         for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
-            let torque = self.health.get(j).is_some_and(|h| h.torque_on);
+            // Only servos whose position has been read: at boot the Basic's power on (0x10)
+            // can arrive before the first state read, and a hold goal at a default position
+            // would make the arm jump.
+            let torque = self
+                .health
+                .get(j)
+                .is_some_and(|h| h.torque_on && h.answering);
             if let (true, Some(&p)) = (torque, present.get(j)) {
                 *slot = Some(Goal {
                     position: p,
@@ -794,8 +844,23 @@ impl Atom {
         } = self.activity
         {
             let elapsed = now_us.saturating_sub(started_us);
-            let arrived = motion::angles_match(&self.present_angles(), &target)
-                && !self.health.iter().take(JOINTS).any(|h| h.moving);
+            // A servo that does not answer cannot arrive: judge by the ones that do.
+            let present = self.present_angles();
+            let answering: [bool; JOINTS] =
+                core::array::from_fn(|j| self.health.get(j).is_some_and(|h| h.answering));
+            let seen: [Centideg; JOINTS] = core::array::from_fn(|j| {
+                if answering.get(j).copied().unwrap_or(false) {
+                    present.get(j).copied().unwrap_or_default()
+                } else {
+                    target.get(j).copied().unwrap_or_default()
+                }
+            });
+            let arrived = motion::angles_match(&seen, &target)
+                && !self
+                    .health
+                    .iter()
+                    .take(JOINTS)
+                    .any(|h| h.answering && h.moving);
             let host_silent =
                 now_us.saturating_sub(self.last_host_cmd_us) >= self.config.timing.jog_watchdog_us;
             if jog && host_silent {
@@ -983,7 +1048,12 @@ impl Atom {
             return;
         }
         if h.torque_reported != h.torque_on {
-            if let Some(op) = Op::write(id, reg::TORQUE_ENABLE, &[u8::from(h.torque_on)]) {
+            let op = if h.torque_on {
+                self.torque_on_op(index, id)
+            } else {
+                Op::write(id, reg::TORQUE_ENABLE, &[0])
+            };
+            if let Some(op) = op {
                 self.queue_op(op, Then::Nothing);
             }
         } else if h.torque_on

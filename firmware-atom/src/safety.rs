@@ -56,6 +56,18 @@ impl SafeGoals {
         &self.0
     }
 
+    /// One WRITE at the torque-enable register (40) switching servo `index` (bus id `id`) on
+    /// together with its move block (41..47): the servo holds the checked goal from the moment
+    /// its torque is on, whatever stale goal its register held.
+    pub fn torque_on_write(&self, index: usize, id: u8) -> Option<crate::driver::Op> {
+        let goal = self.0.get(index).copied().flatten()?;
+        let mut data = [1u8; 1 + reg::MOVE_BLOCK_LEN as usize];
+        if let Some(block) = data.get_mut(1..) {
+            block.copy_from_slice(&goal.move_block());
+        }
+        crate::driver::Op::write(id, reg::TORQUE_ENABLE, &data)
+    }
+
     /// The SYNC WRITE of the move blocks to the servos with a goal (`ids` per index).
     pub fn sync_write(&self, ids: &[u8; SERVOS]) -> Option<protocol_core::servo::Packet> {
         let mut b = SyncWriteBuilder::new(reg::MOVE_BLOCK, reg::MOVE_BLOCK_LEN);

@@ -427,3 +427,32 @@ fn lost_goal_and_torque_writes_are_repaired_from_the_read_back() {
     rig.run_ms(30);
     assert!(rig.bus.servo(2).torque_on());
 }
+
+#[test]
+fn power_on_before_the_first_state_read_does_not_move_the_arm() {
+    // The real arm: unpowered at boot, joints somewhere away from zero; the Basic sends power
+    // on at once.
+    let mut bus = support::FakeBus::new(true);
+    bus.servo(2).position = 2500.0;
+    bus.servo(2).table[40] = 0;
+    let mut rig = Rig {
+        atom: firmware_atom::Atom::new(firmware_atom::AtomConfig::default()),
+        bus,
+        usb: support::FakeUsb::default(),
+        io: firmware_atom::RecordingIo::default(),
+    };
+    assert_eq!(rig.ask(0x10, &[]), [1]);
+    rig.run_ms(100);
+    let enc = rig.ask_i16(0x3D, &[]);
+    assert!(
+        (enc[1] - 2500).abs() <= 2,
+        "joint 2 stayed where it was: {enc:?}"
+    );
+    assert!(
+        rig.bus
+            .servo(2)
+            .goals
+            .iter()
+            .all(|&g| (g - 2500).abs() <= 2)
+    );
+}
