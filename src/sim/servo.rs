@@ -238,9 +238,10 @@ impl SimServo {
         self.reg_u16(reg::GOAL_POSITION)
     }
 
-    /// True while torque is enabled (register 40).
+    /// True while the motor holds the shaft (register 40 = 1). With 0 (off) and 2 (damping)
+    /// the shaft is free: it stays where it is unless moved by hand.
     pub fn torque_enabled(&self) -> bool {
-        self.reg(reg::TORQUE_ENABLE) != 0
+        self.reg(reg::TORQUE_ENABLE) == 1
     }
 
     /// True while the shaft is moving or has not reached its goal (register 66).
@@ -568,18 +569,18 @@ impl SimServo {
                 let present = self.present_position();
                 self.set_u16(reg::GOAL_POSITION, present);
             }
-            0 => {
-                self.set_reg(reg::TORQUE_ENABLE, 0);
+            0 | 2 => {
+                self.set_reg(reg::TORQUE_ENABLE, value);
                 self.velocity_steps_per_s = 0.0;
                 let present = self.present_position();
                 self.set_u16(reg::GOAL_POSITION, present);
             }
-            v => {
+            _ => {
                 if !self.torque_enabled() {
                     let present = self.present_position();
                     self.set_u16(reg::GOAL_POSITION, present);
                 }
-                self.set_reg(reg::TORQUE_ENABLE, v.min(2));
+                self.set_reg(reg::TORQUE_ENABLE, 1);
             }
         }
     }
@@ -834,6 +835,17 @@ mod tests {
         rig.write(1, reg::TORQUE_ENABLE, &[1]);
         rig.run_for_ms(100);
         assert_eq!(rig.servo(0).present_position(), 1000);
+    }
+
+    #[test]
+    fn damping_mode_leaves_the_shaft_free() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::TORQUE_ENABLE, &[2]);
+        assert_eq!(rig.servo(0).reg(reg::TORQUE_ENABLE), 2);
+        assert!(!rig.servo(0).torque_enabled());
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 3000, 0));
+        rig.run_for_ms(200);
+        assert_eq!(rig.servo(0).present_position(), 2048);
     }
 
     #[test]
