@@ -11,7 +11,7 @@ count() {
     valgrind --tool=callgrind --callgrind-out-file=/dev/null "$BIN" "$1" "$2" 2>&1 \
         | sed -n 's/.*Collected : \([0-9]*\).*/\1/p'
 }
-for what in ik fk; do
+for what in ik ik-far fk; do
     base=$(count 0 "$what")
     many=$(count "$N" "$what")
     echo "$what: $(( (many - base) / N )) instructions per call (N=$N)"

@@ -1,5 +1,6 @@
-//! Runs `N` (first argument, default 0) inverse-kinematics solves and forward-kinematics calls,
-//! for counting instructions with callgrind; see `benches/callgrind.sh`.
+//! Runs `N` (first argument, default 0) calls of `ik` (seeded with the answer's neighbourhood),
+//! `ik-far` (seeded with the zero pose) or `fk` (second argument), for counting instructions
+//! with callgrind; see `benches/callgrind.sh`.
 #![allow(missing_docs)]
 
 use kinematics_core::{JointAngles, Kinematics};
@@ -18,6 +19,10 @@ fn main() {
     for _ in 0..n {
         acc ^= match what.as_str() {
             "fk" => kin.forward(black_box(&q)).x,
+            // Seeded far from the answer (a large move).
+            "ik-far" => kin
+                .inverse(black_box(&pose), black_box(&JointAngles::default()))
+                .map_or(0, |s| s.0[0]),
             _ => kin
                 .inverse(black_box(&pose), black_box(&q))
                 .map_or(0, |s| s.0[0]),

@@ -47,6 +47,8 @@ impl Angle {
     pub const ZERO: Self = Self(0);
     /// A quarter turn (+90 deg).
     pub const QUARTER: Self = Self(1 << 30);
+    /// Half a turn (180 deg).
+    pub const HALF: Self = Self(i32::MIN);
 
     /// The angle of `centideg` hundredths of a degree (any value; wraps).
     pub const fn from_centideg(centideg: i32) -> Self {

@@ -91,7 +91,14 @@ pub(crate) struct Branch {
     pub theta: [Angle; 6],
     /// How well it reaches the target.
     pub fit: Fit,
+    /// Within [`ILL_CONDITIONED`] of a singularity, where the wire's rounding of the target can
+    /// move joints by more than a few hundredths of a degree.
+    pub ill_conditioned: bool,
 }
+
+/// Distance from a singularity (20 deg: of the shoulder angle phi, the elbow angle t3, or t5
+/// from +-90 deg) within which a branch counts as ill-conditioned.
+const ILL_CONDITIONED: Angle = Angle::from_centideg(2_000);
 
 /// Each branch that exists, indexed shoulder * 4 + wrist * 2 + elbow.
 pub(crate) type Branches = [Option<Branch>; MAX_BRANCHES];
@@ -283,10 +290,14 @@ pub(crate) fn solve(
                 let (s3, c3) = t3.sin_cos();
                 let t2 = toward_e.sub(atan2(mul(a3, s3), a2 + mul(a3, c3)));
                 let t4 = t234.sub(t2).sub(t3);
+                let ill_conditioned = [phi, t3, t5, t5.sub(Angle::HALF)]
+                    .iter()
+                    .any(|a| a.0.unsigned_abs() < ILL_CONDITIONED.0.unsigned_abs());
                 if let Some(slot) = out.get_mut(shoulder * 4 + wrist * 2 + elbow) {
                     *slot = Some(Branch {
                         theta: [t1, t2, t3, t4, t5, t6],
                         fit,
+                        ill_conditioned,
                     });
                 }
             }

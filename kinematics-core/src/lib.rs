@@ -44,7 +44,7 @@
 //!   a seed that is already at the target to within the wire's rounding is returned as is.
 //!
 //! Host cost (x86-64, release): FK about 0.5 us and 2 300 instructions, IK (all branches and the
-//! selection) about 2 us and 9 400 instructions per call:
+//! selection) about 2 us and 8 900 to 9 500 instructions per call:
 //! * `cargo bench -p kinematics-core` (criterion: FK, IK, a 27-step linear path);
 //! * `kinematics-core/benches/callgrind.sh` (instructions per call, via valgrind's callgrind:
 //!   the difference between runs of `examples/ik_count.rs` with N and with 0 calls);
@@ -107,8 +107,9 @@ impl IkError {
     pub const PROTOCOL_CODE: u8 = 32;
 }
 
-/// A solution farther than this (0.5 deg) from the seed in some joint makes
-/// [`Kinematics::inverse`] check whether the seed already is at the target.
+/// An ill-conditioned solution (next to a singularity) farther than this (0.5 deg) from the
+/// seed in some joint makes [`Kinematics::inverse`] check whether the seed already is at the
+/// target.
 const SEED_CHECK_CENTIDEG: i32 = 50;
 
 /// Position distance (0.09 mm) within which a pose counts as the target: the wire's 0.1 mm
@@ -213,23 +214,25 @@ impl Kinematics {
             branches
                 .iter()
                 .flatten()
-                .filter_map(|b| Some((self.in_limits_near(&b.theta, seed)?, b.fit)))
-                .min_by_key(|((_, distance), fit)| (*fit, *distance))
-                .map(|((q, _), _)| q)
+                .filter_map(|b| Some((self.in_limits_near(&b.theta, seed)?, b)))
+                .min_by_key(|((_, distance), b)| (b.fit, *distance))
+                .map(|((q, _), b)| (q, b.ill_conditioned))
                 .ok_or(IkError::OutsideLimits)
         });
         // Next to a singularity the wire's rounding can move the solution far from the seed, or
         // out of reach, although the seed itself is at the target to within that rounding (a
         // user resending the coordinates just read): then the arm stays where it is.
-        let far_from_seed = best.map_or(true, |q| {
-            q.0.iter()
-                .zip(seed.0.iter())
-                .any(|(a, b)| (a - b).abs() > SEED_CHECK_CENTIDEG)
+        let check_seed = best.map_or(true, |(q, ill_conditioned)| {
+            ill_conditioned
+                && q.0
+                    .iter()
+                    .zip(seed.0.iter())
+                    .any(|(a, b)| (a - b).abs() > SEED_CHECK_CENTIDEG)
         });
-        if far_from_seed && self.limits.contains(seed) && self.reaches(seed, target) {
+        if check_seed && self.limits.contains(seed) && self.reaches(seed, target) {
             return Ok(*seed);
         }
-        best
+        best.map(|(q, _)| q)
     }
 
     /// Whether the end at `q` is within the wire's rounding of `target`.
