@@ -158,8 +158,8 @@ fn within(v: i64, low: Len, high: Len) -> bool {
 }
 
 /// All IK branches for the flange pose `target` (base frame). The seed's DH angles `seed_theta`
-/// settle what the pose leaves open or ill-conditioned: t1 next to the shoulder singularity and
-/// t6 at the wrist singularity.
+/// settle what the pose leaves open or ill-conditioned: t1 next to the shoulder singularity, t3
+/// next to the stretched elbow and t6 at the wrist singularity.
 pub(crate) fn solve(
     links: &Links,
     target: &Transform,
