@@ -14,8 +14,8 @@
 //! given up after its deadline so the next one can go. Requests wait in a bounded queue
 //! meanwhile.
 //!
-//! A reply garbled on the wire (a frame header `FE FE` heard, but no valid frame) is lost for
-//! good: the Atom does not know. The Basic then sends the request again at once, instead of
+//! A reply garbled on the wire (the start of a frame heard but no valid frame, or a frame for
+//! another command) is lost for good: the Atom does not know. The Basic then sends the request again at once, instead of
 //! leaving the host to wait 0.5 s and resend it itself - unless repeating it could move the
 //! arm twice ([`is_repeatable`]: the incremental jogs 0x33 and 0x34).
 
@@ -39,6 +39,9 @@ pub const MAX_QUEUED_US: u64 = timing::HOST_REPLY_DEADLINE_US;
 /// wiring is known to give) may still arrive, in microseconds: two byte times at 1 Mbaud, the
 /// receiver's latency.
 pub const ECHO_GRACE_US: u64 = 20;
+/// Bytes received further apart than this had silence between them (a new transmission
+/// began), in microseconds: one byte time and the reaction time.
+const BURST_GAP_US: u64 = timing::wire_time_us(1, timing::BUS_BAUD) + REACTION_US;
 /// Longest back-off after a collision, in microseconds.
 pub const MAX_BACKOFF_US: u64 = 2_000;
 /// How late a station may act on what the wire did (its poll period, receiver latency), in
@@ -120,13 +123,16 @@ enum Stage {
         collided: bool,
         tx_done_us: Option<u64>,
     },
-    /// Sent; waiting for the reply until `deadline_us`. `last_fe` is whether the last byte
-    /// heard was `FE`; `header_open` whether a `FE FE` header has been heard that no valid
-    /// frame has completed yet.
+    /// Sent; waiting for the reply until `deadline_us`. `reply_started` is whether a reply
+    /// seems to have come but not as a valid frame with our CMD: an `FE` that begins a
+    /// transmission (the first byte heard, or one after a silence; servo packets begin with
+    /// `FF`), `FE FE` anywhere, or a valid frame for another command. `heard_any` and
+    /// `last_fe` track what came before.
     AwaitReply {
         deadline_us: u64,
+        heard_any: bool,
         last_fe: bool,
-        header_open: bool,
+        reply_started: bool,
     },
 }
 
@@ -207,6 +213,7 @@ impl Forwarder {
         config: &BasicConfig,
         mut on_event: impl FnMut(Event),
     ) {
+        let silence_before = now_us.saturating_sub(self.last_rx_us) > BURST_GAP_US;
         self.last_activity_us = now_us;
         self.last_rx_us = now_us;
         if let Some(InFlight {
@@ -232,15 +239,18 @@ impl Forwarder {
         if let Some(InFlight {
             stage:
                 Stage::AwaitReply {
+                    heard_any,
                     last_fe,
-                    header_open,
+                    reply_started,
                     ..
                 },
             ..
         }) = &mut self.current
         {
-            *header_open |= *last_fe && byte == HEADER;
+            let starts_transmission = !*heard_any || silence_before;
+            *reply_started |= byte == HEADER && (starts_transmission || *last_fe);
             *last_fe = byte == HEADER && !*last_fe;
+            *heard_any = true;
         }
         let mut next = self.decoder.push(byte);
         while let Some(frame) = next {
@@ -249,7 +259,7 @@ impl Forwarder {
         }
         let garbled = matches!(
             &self.current,
-            Some(InFlight { stage: Stage::AwaitReply { header_open: true, .. }, request, .. })
+            Some(InFlight { stage: Stage::AwaitReply { reply_started: true, .. }, request, .. })
                 if is_repeatable(&request.frame)
         ) && !self.decoder.has_partial();
         if garbled {
@@ -405,8 +415,9 @@ impl Forwarder {
             };
             flight.stage = Stage::AwaitReply {
                 deadline_us: now_us.saturating_add(timeout_us),
+                heard_any: false,
                 last_fe: false,
-                header_open: false,
+                reply_started: false,
             };
         }
     }
@@ -452,12 +463,13 @@ impl Forwarder {
             });
         } else {
             if let Some(InFlight {
-                stage: Stage::AwaitReply { header_open, .. },
+                stage: Stage::AwaitReply { reply_started, .. },
                 ..
             }) = &mut self.current
             {
-                // That header belonged to this valid frame.
-                *header_open = false;
+                // The Atom sends frames only to answer the Basic: another command's frame now
+                // is our reply with its CMD byte garbled (or a reply too late to matter).
+                *reply_started = true;
             }
             on_event(Event::Unsolicited);
         }
