@@ -167,6 +167,10 @@ fn main() {
     }
     let busy_ns = t.elapsed().as_nanos() as f64 / polls as f64;
     println!(
+        "RAM of one Basic (all buffers included): {} bytes",
+        std::mem::size_of::<firmware_basic::Basic>()
+    );
+    println!(
         "host CPU per rig step (Basic poll + simulated wire): idle {idle_ns:.0} ns, busy {busy_ns:.0} ns"
     );
 }
