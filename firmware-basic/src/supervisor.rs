@@ -49,10 +49,10 @@ impl Supervisor {
         self.status.last_error = Some(error);
     }
 
-    /// A host request with command `cmd` is about to be forwarded.
-    pub(crate) fn on_host_request(&mut self, cmd: u8) {
+    /// A host frame with command `code` arrived (framed mode).
+    pub(crate) fn on_host_request(&mut self, code: u8) {
         self.status.host_frames = self.status.host_frames.wrapping_add(1);
-        if matches!(cmd, cmd::POWER_OFF | cmd::RELEASE_ALL_SERVOS) {
+        if matches!(code, cmd::POWER_OFF | cmd::RELEASE_ALL_SERVOS) {
             // The host has taken charge of the arm's power: do not power it on behind its back.
             self.power_on_pending = false;
         }
@@ -106,8 +106,9 @@ impl Supervisor {
                 self.last_answer_us = now_us;
                 let done = reply.data() == [1];
                 match (request.frame.cmd(), reply.data()) {
-                    (cmd::POWER_ON, _) if done => {
-                        status.atom_powered = Some(true);
+                    (cmd::POWER_ON, _) => {
+                        // Answered either way: the Atom is alive and has decided.
+                        status.atom_powered = Some(done);
                         self.power_on_pending = false;
                     }
                     (cmd::POWER_OFF, _) if done => status.atom_powered = Some(false),
