@@ -35,6 +35,7 @@ fn without_a_basic_the_atom_usb_port_drives_the_arm() {
             .zip(target)
             .all(|(a, t)| (a.0 - t.0).abs() <= ANGLE_TOLERANCE)
     }));
+    robot.run_for(200_000);
     let Reply::Angles(reported) = ask_on(&mut robot, HostLink::AtomUsb, Request::GetAngles) else {
         panic!("no angles");
     };

@@ -344,7 +344,6 @@ impl SimServo {
             };
             let error = goal - self.raw_position_steps;
             let v = self.velocity_steps_per_s;
-            let braking = v * v / (2.0 * accel);
             // Speed we want now: towards the goal, capped so that we can still stop in time.
             let wanted = error.signum() * speed.min((2.0 * accel * error.abs()).sqrt());
             let dv = (wanted - v).clamp(-accel * dt_s, accel * dt_s);
@@ -353,8 +352,8 @@ impl SimServo {
                 v_next = 0.0;
             }
             let step = (v + v_next) / 2.0 * dt_s;
-            if step.abs() >= error.abs() && braking <= error.abs() + 1.0 {
-                // Arrives within this step.
+            if step * error >= 0.0 && step.abs() >= error.abs() {
+                // Arrives within this step: the position loop holds it there (no overshoot).
                 self.raw_position_steps = goal;
                 self.velocity_steps_per_s = 0.0;
             } else {
@@ -800,6 +799,25 @@ mod tests {
         assert!(!rig.servo(0).is_moving());
         let state = rig.read(1, reg::STATE_BLOCK, reg::STATE_BLOCK_LEN).unwrap();
         assert_eq!(state.u16_at(2), Some(0));
+    }
+
+    #[test]
+    fn arrives_exactly_at_the_goal_without_overshoot() {
+        for (accel, speed) in [(0, 0), (20, 3000), (5, 400), (254, 500)] {
+            let mut rig = Rig::new(&[1]);
+            rig.write(1, reg::TORQUE_ENABLE, &[1]);
+            rig.write(1, reg::MOVE_BLOCK, &move_block(accel, 2788, speed));
+            let mut furthest = 0;
+            for _ in 0..3_000 {
+                rig.run_for_ms(1);
+                furthest = furthest.max(rig.servo(0).present_position());
+                if !rig.servo(0).is_moving() {
+                    break;
+                }
+            }
+            assert_eq!(furthest, 2788, "accel {accel} speed {speed}");
+            assert_eq!(rig.servo(0).present_position(), 2788);
+        }
     }
 
     #[test]
