@@ -12,7 +12,9 @@
 
 use heapless::Deque;
 use protocol_core::servo::{Packet, reg, sign_magnitude};
-use protocol_core::timing::{ATOM_TRANSACTION_GAP_US, BUS_BAUD, HOST_FRAME_GAP_US, wire_time_us};
+use protocol_core::timing::{
+    ATOM_TRANSACTION_GAP_US, BUS_BAUD, BUS_QUIET_BEFORE_SEND_US, HOST_FRAME_GAP_US, wire_time_us,
+};
 use protocol_core::units::{Centideg, Steps};
 use protocol_core::{BytePort, Frame, FrameDecoder};
 
@@ -70,6 +72,10 @@ const IN_POSITION_STEPS: i32 = 10;
 /// 300 us: far beyond the echo's arrival (tens of us), far below the time a client needs to
 /// receive that reply through the Basic and send a new request (over a millisecond at 115200).
 const OWN_REPLY_WINDOW_US: u64 = 300;
+
+/// How often a bus reply is sent again after a collision garbled it: twice, then the host's
+/// own resend takes over.
+const REPLY_RESENDS: u8 = 2;
 
 /// Which host link a request came from (its reply goes back there).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -166,6 +172,13 @@ pub struct Atom {
     /// heard before then is our own echo that slipped past the echo filter (some replies,
     /// e.g. angles to coords, have the layout of a valid request).
     last_bus_reply: Option<(Frame, u64)>,
+    /// True while the last thing the Atom put on the bus was a host reply (so a collision
+    /// reported by the echo concerns it).
+    reply_on_wire: bool,
+    /// Resends left for the last bus reply after collisions.
+    reply_resends: u8,
+    /// A reply to send again once the wire is quiet (its first copy collided).
+    resend_reply: Option<Frame>,
     // Bus schedule.
     driver: ServoDriver,
     jobs: Deque<Job, OP_QUEUE>,
@@ -250,6 +263,9 @@ impl Atom {
             usb_last_rx_us: 0,
             bus_reply: None,
             last_bus_reply: None,
+            reply_on_wire: false,
+            reply_resends: 0,
+            resend_reply: None,
             driver: ServoDriver::new(config.timing.reply_margin_us),
             jobs: Deque::new(),
             pending_goals: None,
@@ -294,6 +310,15 @@ impl Atom {
     ) {
         self.now_us = now_us;
         self.receive_bus(now_us, bus, usb, io);
+        if self.rx.take_collision()
+            && self.reply_on_wire
+            && self.reply_resends > 0
+            && let Some((reply, _)) = &self.last_bus_reply
+        {
+            // The Basic never got it; an incremental jog must not be resent by the host.
+            self.reply_resends -= 1;
+            self.resend_reply = Some(reply.clone());
+        }
         self.receive_usb(now_us, usb, io);
         if let Some((op, outcome)) = self.driver.poll(now_us, bus) {
             self.finish(op, outcome, usb);
@@ -400,12 +425,31 @@ impl Atom {
         if self.driver.busy() {
             return;
         }
-        if let Some(reply) = self.bus_reply.take() {
+        let resend_due = self.resend_reply.is_some()
+            && self.rx.quiet_us(now_us) >= BUS_QUIET_BEFORE_SEND_US
+            && !self.rx.frame_in_progress();
+        let fresh = self.bus_reply.take();
+        if fresh.is_some() {
+            self.reply_resends = REPLY_RESENDS;
+            self.resend_reply = None;
+        }
+        if let Some(reply) = fresh.or_else(|| {
+            if resend_due {
+                self.resend_reply.take()
+            } else {
+                None
+            }
+        }) {
             let bytes = reply.to_bytes();
             bus.write(&bytes);
             self.rx.on_transmit(now_us, &bytes);
             let window_us = wire_time_us(bytes.len() as u32, BUS_BAUD) + OWN_REPLY_WINDOW_US;
             self.last_bus_reply = Some((reply, now_us + window_us));
+            self.reply_on_wire = true;
+            return;
+        }
+        if self.resend_reply.is_some() {
+            // Hold the servo schedule until the resent reply is out.
             return;
         }
         if self.rx.frame_in_progress()
@@ -426,8 +470,10 @@ impl Atom {
         } else {
             self.next_refresh_op()
         };
-        if let Some(op) = op {
-            self.driver.start(now_us, op, bus, &mut self.rx);
+        if let Some(op) = op
+            && self.driver.start(now_us, op, bus, &mut self.rx)
+        {
+            self.reply_on_wire = false;
         }
     }
 

@@ -48,6 +48,10 @@ pub struct BusReceiver {
     last_activity_us: u64,
     /// Bytes dropped as own echo.
     echo_bytes: u32,
+    /// True once a whole transmission came back as echo: the line echoes.
+    line_echoes: bool,
+    /// Set when, on a line that echoes, a transmission came back different (a collision).
+    collided: bool,
 }
 
 impl BusReceiver {
@@ -78,10 +82,14 @@ impl BusReceiver {
                 if self.expected_echo.is_empty() {
                     self.echo_bytes = self.echo_bytes.wrapping_add(self.held.len() as u32);
                     self.held.clear();
+                    self.line_echoes = true;
                 }
                 return;
             }
             // Not our echo: the line does not echo, or a collision changed it.
+            if self.line_echoes {
+                self.collided = true;
+            }
             self.expected_echo.clear();
             self.release_held(on_event);
         }
@@ -92,8 +100,12 @@ impl BusReceiver {
     /// short by a quiet line. Call once per poll, after the received bytes.
     pub fn on_time(&mut self, now_us: u64, on_event: &mut impl FnMut(BusEvent)) {
         if now_us > self.echo_deadline_us && !self.expected_echo.is_empty() {
-            // The echo never (fully) came: a line without echo. The bytes that matched so far
-            // may be the start of a servo's answer (it begins like the instruction did).
+            // The echo never (fully) came: a line without echo (the bytes that matched so far
+            // may be the start of a servo's answer, which begins like the instruction did), or
+            // on a line that echoes, a transmission garbled beyond recognition.
+            if self.line_echoes {
+                self.collided = true;
+            }
             self.expected_echo.clear();
             self.release_held(on_event);
         }
@@ -112,6 +124,12 @@ impl BusReceiver {
                 next = self.frames.next_frame();
             }
         }
+    }
+
+    /// True (once) if the last transmission collided: the line echoes and the echo differed or
+    /// did not come back whole.
+    pub fn take_collision(&mut self) -> bool {
+        core::mem::take(&mut self.collided)
     }
 
     /// True while a host frame is arriving (its start seen, its end not yet).
@@ -222,6 +240,21 @@ mod tests {
             run(&mut rx, 500, &request.to_bytes()),
             [BusEvent::Frame(request)]
         );
+    }
+
+    #[test]
+    fn collision_is_reported_on_a_line_that_echoes() {
+        let mut rx = BusReceiver::new();
+        let reply = Frame::new(0x20, &[0; 12]).unwrap().to_bytes();
+        rx.on_transmit(0, &reply);
+        run(&mut rx, 10, &reply);
+        assert!(!rx.take_collision());
+        rx.on_transmit(1000, &reply);
+        let mut garbled = reply.clone();
+        garbled[6] ^= 0x10;
+        run(&mut rx, 1010, &garbled);
+        assert!(rx.take_collision());
+        assert!(!rx.take_collision(), "reported once");
     }
 
     #[test]
