@@ -174,10 +174,13 @@ class QueueTest(RobotTestCase):
         self.home()
 
     def test_sync_send_angles_returns_once_arrived(self):
-        self.home()
-        target = [-20, 15, -25, 10, 20, -30]
-        self.mc.sync_send_angles(target, 100, timeout=6)
-        self.assertAnglesClose(self.mc.get_angles(), target, tol=0.5, msg="after sync_send_angles")
+        # pymycobot's sync_send_angles polls is_in_position and returns when it answers 1, so
+        # the firmware must not call a pose reached while the arm is still on its way.
+        for speed in (80, 30):
+            self.home()
+            target = [-20, 15, -25, 10, 20, -30]
+            self.mc.sync_send_angles(target, speed, timeout=8)
+            self.assertAnglesClose(self.mc.get_angles(), target, msg=f"right after sync_send_angles at speed {speed}")
         self.home()
 
 
