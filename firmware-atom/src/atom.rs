@@ -187,6 +187,8 @@ pub struct Atom {
     refresh_round: u8,
     owe_refresh: bool,
     refresh_rounds_done: u32,
+    /// The receiver's checksum-error count when the transaction in flight started.
+    checksum_errors_at_start: u32,
     // Robot state.
     pub(crate) powered: bool,
     pub(crate) free_mode: bool,
@@ -273,6 +275,7 @@ impl Atom {
             refresh_round: 0,
             owe_refresh: false,
             refresh_rounds_done: 0,
+            checksum_errors_at_start: 0,
             powered: config.powered_at_boot,
             free_mode: false,
             fresh_mode: true,
@@ -474,6 +477,7 @@ impl Atom {
             && self.driver.start(now_us, op, bus, &mut self.rx)
         {
             self.reply_on_wire = false;
+            self.checksum_errors_at_start = self.rx.checksum_errors();
         }
     }
 
@@ -527,6 +531,8 @@ impl Atom {
                     }
                     _ => {
                         h.comm_errors = h.comm_errors.wrapping_add(1);
+                        h.corrupt_answers =
+                            self.rx.checksum_errors() != self.checksum_errors_at_start;
                         h.misses = h.misses.saturating_add(1);
                         if h.misses >= self.config.timing.misses_before_lost {
                             h.answering = false;
@@ -1060,6 +1066,7 @@ fn apply_state(h: &mut ServoHealth, p: &Packet) {
     h.answering = true;
     h.ever_answered = true;
     h.misses = 0;
+    h.corrupt_answers = false;
     h.position = Steps(sign_magnitude(word(reg::PRESENT_POSITION), 15));
     h.speed_steps_per_s = sign_magnitude(word(reg::PRESENT_SPEED), 15);
     h.load_permille = sign_magnitude(word(reg::PRESENT_LOAD), 10);

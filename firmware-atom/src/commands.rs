@@ -30,6 +30,10 @@ const SYSTEM_VERSION_X10: u8 = 70;
 /// Reported by get modify version (0x01).
 const MODIFY_VERSION: u8 = 0;
 
+/// What get servo status (0xE4) reports for a servo that does not answer: every bit set, a
+/// value no answering servo reports (its status register has six fault bits).
+const NO_ANSWER_STATUS: u8 = 0xFF;
+
 /// Servo registers below this address are EEPROM: writes need the lock (55) opened first.
 const FIRST_RAM_REGISTER: u8 = reg::TORQUE_ENABLE;
 
@@ -407,7 +411,13 @@ fn execute<I: AtomIo>(
             (i32::from(h.current_raw) * 65 / 10).clamp(-32_768, 32_767) as i16
         }))),
         R::GetServoVoltages => Answer::Now(Reply::Bytes6(per_joint(atom, |h| h.voltage_decivolt))),
-        R::GetServoStatus => Answer::Now(Reply::Bytes6(per_joint(atom, |h| h.fault_bits))),
+        R::GetServoStatus => Answer::Now(Reply::Bytes6(per_joint(atom, |h| {
+            if h.answering {
+                h.fault_bits
+            } else {
+                NO_ANSWER_STATUS
+            }
+        }))),
         R::GetServoTemps => Answer::Now(Reply::Bytes6(per_joint(atom, |h| h.temperature_c))),
         // Servo parameters live in the servos' own EEPROM; there is nothing to back up.
         R::BackupServoParams { .. } | R::RestoreServoParams { .. } => Answer::Done(Ok(())),
@@ -555,6 +565,7 @@ fn per_joint<T: Default + Copy>(
 fn servo_errors(atom: &Atom) -> [u8; SERVOS] {
     core::array::from_fn(|i| {
         let code = match atom.servo_health(i) {
+            Some(h) if !h.answering && h.corrupt_answers => ServoErrorCode::BadAnswer,
             Some(h) if !h.answering => ServoErrorCode::NoAnswer,
             Some(h) if h.fault_bits & ServoErrorCode::FAULT_MASK != 0 => {
                 ServoErrorCode::Fault(h.fault_bits)

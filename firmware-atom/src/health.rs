@@ -35,6 +35,8 @@ pub struct ServoHealth {
     pub goal_reported: Steps,
     /// Failed transactions (timeouts and bad checksums) since boot. Wraps.
     pub comm_errors: u32,
+    /// True if the last failed read got a corrupt answer (bad checksum) rather than none.
+    pub corrupt_answers: bool,
     /// Consecutive missed state reads.
     pub(crate) misses: u8,
 }

@@ -280,6 +280,11 @@ fn missing_servo_is_reported_and_others_keep_working() {
     assert_eq!(rig.ask(0x51, &[]), [0]);
     let errors = rig.ask(0x15, &[]);
     assert_eq!(errors, [0, 0, 0, 16, 0, 0, 0]);
+    assert_eq!(
+        rig.ask(0xE4, &[]),
+        [0, 0, 0, 0xFF, 0, 0],
+        "status of a silent servo"
+    );
     // Reading the missing servo answers (after bounded retries) instead of hanging.
     assert_eq!(rig.ask(0x53, &[4, 63]), [0xFF]);
     let mut data = be(&[1000, 0, 0, 0, 0, 0]);
@@ -299,6 +304,15 @@ fn servo_fault_is_reported() {
     assert_eq!(rig.ask(0x15, &[])[4], 36);
     assert_eq!(rig.ask(0xE5, &[]), [31; 6]);
     assert_eq!(rig.ask(0xE3, &[]), [120; 6]);
+}
+
+#[test]
+fn a_servo_with_corrupt_answers_is_reported_as_such() {
+    let mut rig = Rig::new();
+    rig.bus.servo(6).corrupt_answers = u32::MAX;
+    rig.run_ms(50);
+    assert_eq!(rig.ask(0x15, &[]), [0, 0, 0, 0, 0, 17, 0]);
+    assert_eq!(angles(&mut rig), [0; 6], "the host is still served");
 }
 
 #[test]
