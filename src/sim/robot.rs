@@ -134,6 +134,9 @@ impl UsbLink {
 
 struct BasicBoard {
     firmware: Basic,
+    config: BasicConfig,
+    /// When the firmware last started, in ns: its clock starts at 0 there.
+    boot_ns: u64,
     station: StationId,
     usb: UsbLink,
     io: SimBasicIo,
@@ -176,6 +179,9 @@ pub struct VirtualRobot {
     bus: Bus,
     basic: Option<BasicBoard>,
     atom: Atom,
+    atom_config: AtomConfig,
+    /// When the Atom firmware last started, in ns: its clock starts at 0 there.
+    atom_boot_ns: u64,
     atom_station: StationId,
     atom_usb: UsbLink,
     atom_io: RecordingIo,
@@ -194,6 +200,8 @@ impl VirtualRobot {
         let mut bus = Bus::mycobot(config.seed);
         let basic = config.with_basic.then(|| BasicBoard {
             firmware: Basic::new(config.basic),
+            config: config.basic,
+            boot_ns: 0,
             station: bus.attach(config.basic_hears_echo),
             usb: UsbLink::new(),
             io: SimBasicIo::default(),
@@ -213,6 +221,8 @@ impl VirtualRobot {
             bus,
             basic,
             atom: Atom::new(config.atom),
+            atom_config: config.atom,
+            atom_boot_ns: 0,
             atom_station,
             atom_usb: UsbLink::new(),
             atom_io: RecordingIo::default(),
@@ -274,6 +284,26 @@ impl VirtualRobot {
         match link {
             HostLink::Basic => self.basic.as_mut().map(|b| &mut b.usb),
             HostLink::AtomUsb => Some(&mut self.atom_usb),
+        }
+    }
+
+    /// Resets the Atom now (brown-out, reset button): its firmware starts again from
+    /// [`Atom::new`] with its clock at 0 and its UART buffers empty. The servos keep their
+    /// torque, goals and positions.
+    pub fn reset_atom(&mut self) {
+        self.atom = Atom::new(self.atom_config);
+        self.atom_boot_ns = self.now_ns;
+        self.bus.reset_station(self.atom_station);
+    }
+
+    /// Resets the Basic now, like [`VirtualRobot::reset_atom`]; what the host sent and the
+    /// Basic had not read yet is lost. No-op without a Basic.
+    pub fn reset_basic(&mut self) {
+        if let Some(basic) = self.basic.as_mut() {
+            basic.firmware = Basic::new(basic.config);
+            basic.boot_ns = self.now_ns;
+            basic.usb = UsbLink::new();
+            self.bus.reset_station(basic.station);
         }
     }
 
@@ -344,19 +374,20 @@ impl VirtualRobot {
                 s.servo.transmit_due(now_ns, &mut port);
             }
         }
-        let now_us = now_ns / 1_000;
         if let Some(basic) = self.basic.as_mut()
             && let Some(mut bus) = self.bus.port(basic.station)
         {
             let mut host = basic.usb.board_port(now_ns);
+            let basic_us = (now_ns - basic.boot_ns) / 1_000;
             basic
                 .firmware
-                .poll(now_us, &mut host, &mut bus, &mut basic.io);
+                .poll(basic_us, &mut host, &mut bus, &mut basic.io);
         }
         if let Some(mut bus) = self.bus.port(self.atom_station) {
             let mut usb = self.atom_usb.board_port(now_ns);
+            let atom_us = (now_ns - self.atom_boot_ns) / 1_000;
             self.atom
-                .poll(now_us, &mut bus, &mut usb, &mut self.atom_io);
+                .poll(atom_us, &mut bus, &mut usb, &mut self.atom_io);
         }
         self.bus.start_transmissions(now_ns);
         self.next_poll_ns = now_ns + POLL_PERIOD_NS;

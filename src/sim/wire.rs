@@ -129,6 +129,15 @@ impl Bus {
         StationId(self.stations.len() - 1)
     }
 
+    /// Empties a station's receive buffer and transmit queue, as a board reset does to its
+    /// UART; a byte already on the wire still finishes.
+    pub fn reset_station(&mut self, id: StationId) {
+        if let Some(station) = self.stations.get_mut(id.0) {
+            station.rx.clear();
+            station.tx.clear();
+        }
+    }
+
     /// Starts (or stops) keeping every delivered byte, with its sender, for
     /// [`Bus::take_heard`]. Off by default.
     pub fn set_tap(&mut self, on: bool) {
