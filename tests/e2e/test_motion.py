@@ -132,6 +132,16 @@ class CoordMoveTest(RobotTestCase):
         self.wait_coords(target)
         self.home()
 
+    def test_sync_send_coords_returns_at_the_target(self):
+        for mode, angles in ((0, [20, -20, -70, 10, 40, 10]), (1, [5, -35, -55, 5, 35, 5])):
+            self.start_from(WORK)
+            target = [round(v, 1) for v in fk(angles)]
+            self.mc.sync_send_coords(target, 50, mode, timeout=8)
+            coords = self.mc.get_coords()
+            self.assertLessEqual(position_error_mm(coords, target), 1.0, f"mode {mode}: {coords} vs {target}")
+            self.assertLessEqual(rotation_error_deg(coords[3:], target[3:]), 0.5, f"mode {mode}: {coords}")
+        self.home()
+
     def test_unreachable_coords_are_refused_with_error_32(self):
         before = self.start_from(WORK)
         angles_before = self.mc.get_angles()
