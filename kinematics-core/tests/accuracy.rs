@@ -14,7 +14,7 @@
 use kinematics_core::{ArmGeometry, IkError, JointAngles, JointLimits, Kinematics, Pose};
 
 #[cfg(debug_assertions)]
-const SAMPLES: usize = 4_000;
+const SAMPLES: usize = 10_000;
 #[cfg(not(debug_assertions))]
 const SAMPLES: usize = 100_000;
 
