@@ -5,9 +5,9 @@ use heapless::Deque;
 use protocol_core::frame::MAX_FRAME_BYTES;
 use protocol_core::{BytePort, Frame, FrameDecoder, timing};
 
-/// Bytes waiting for the host link. Replies are written one at a time, so this only fills in
-/// transparent mode when the bus (1 Mbaud) outpaces the host link (115200): 512 bytes is
-/// 44 ms of host link time.
+/// Bytes waiting for the host link: 44 ms of 115200. In framed mode the forwarder starts a
+/// request only while a reply of any size still fits, so replies are never dropped; in
+/// transparent mode a busy bus (1 Mbaud) outpaces the host link and the oldest bytes go.
 pub const HOST_TX_CAPACITY: usize = 512;
 /// Most bytes handed to the host port in one write: well under the ESP32 UART's 128-byte FIFO,
 /// so a write into an idle transmitter never waits.
