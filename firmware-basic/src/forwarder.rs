@@ -475,3 +475,38 @@ impl Forwarder {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_basic_starts_only_early_in_a_gap_or_after_it() {
+        let starts: std::vec::Vec<u64> = (0..200).filter(|&q| may_start_after_quiet(q)).collect();
+        // Never while a servo may still answer, never late in the Atom's 100 us gap.
+        assert_eq!(starts.first(), Some(&timing::BUS_QUIET_BEFORE_SEND_US));
+        assert!(starts.contains(&(LATEST_START_IN_GAP_US - 1)));
+        assert!(
+            !starts
+                .iter()
+                .any(|q| (LATEST_START_IN_GAP_US..ATOM_START_SEEN_US).contains(q))
+        );
+        assert!(starts.contains(&ATOM_START_SEEN_US));
+        const { assert!(LATEST_START_IN_GAP_US > timing::BUS_QUIET_BEFORE_SEND_US) };
+    }
+
+    #[test]
+    fn only_incremental_jogs_are_never_repeated() {
+        let frame = |cmd: u8, data: &[u8]| Frame::new(cmd, data).unwrap();
+        assert!(!is_repeatable(&frame(
+            cmd::JOG_INCREMENT_ANGLE,
+            &[1, 0, 100, 50]
+        )));
+        assert!(!is_repeatable(&frame(
+            cmd::JOG_INCREMENT_COORD,
+            &[1, 0, 100, 50]
+        )));
+        assert!(is_repeatable(&frame(cmd::GET_ANGLES, &[])));
+        assert!(is_repeatable(&frame(cmd::SEND_ANGLES, &[0; 13])));
+    }
+}
