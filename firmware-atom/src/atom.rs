@@ -40,7 +40,7 @@ const MOTION_QUEUE: usize = 16;
 
 /// A servo that stopped answering is probed only every this many refresh rounds, so a missing
 /// servo (often the gripper) does not cost its timeout in every round.
-const LOST_SERVO_PROBE_ROUNDS: u8 = 8;
+const LOST_SERVO_PROBE_ROUNDS: u32 = 8;
 
 /// Acceleration register of the fastest joint during stepped (linear, jog) motion: 254 x 100
 /// steps/s^2, the servo reaches full joint speed in under 70 ms.
@@ -184,7 +184,6 @@ pub struct Atom {
     jobs: Deque<Job, OP_QUEUE>,
     pending_goals: Option<safety::SafeGoals>,
     refresh_next: usize,
-    refresh_round: u8,
     owe_refresh: bool,
     refresh_rounds_done: u32,
     /// The receiver's checksum-error count when the transaction in flight started.
@@ -272,7 +271,6 @@ impl Atom {
             jobs: Deque::new(),
             pending_goals: None,
             refresh_next: 0,
-            refresh_round: 0,
             owe_refresh: false,
             refresh_rounds_done: 0,
             checksum_errors_at_start: 0,
@@ -488,14 +486,17 @@ impl Atom {
             self.refresh_next += 1;
             if self.refresh_next >= SERVOS {
                 self.refresh_next = 0;
-                self.refresh_round = self.refresh_round.wrapping_add(1);
                 self.refresh_rounds_done = self.refresh_rounds_done.wrapping_add(1);
             }
             let lost = self
                 .health
                 .get(index)
                 .is_some_and(|h| !h.answering && h.misses >= self.config.timing.misses_before_lost);
-            if lost && !self.refresh_round.is_multiple_of(LOST_SERVO_PROBE_ROUNDS) {
+            if lost
+                && !self
+                    .refresh_rounds_done
+                    .is_multiple_of(LOST_SERVO_PROBE_ROUNDS)
+            {
                 continue;
             }
             let id = *self.config.servo_ids.get(index)?;

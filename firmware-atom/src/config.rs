@@ -117,7 +117,7 @@ pub struct TimingBudget {
     /// checksum before the command fails (`servo-bus.md`: corrupted replies are retried).
     pub retries: u8,
     /// Consecutive missed state reads after which a servo is reported as not answering. Three
-    /// misses = about 1.5 ms of lost data: one collision never marks a servo dead.
+    /// misses = three refresh rounds, about 12 ms: one collision never marks a servo dead.
     pub misses_before_lost: u8,
     /// Period of the straight-line and jog interpolators: a new set of goals every 20 ms, short
     /// enough that the servos' own ramp keeps the path within a fraction of a millimetre.
@@ -126,8 +126,6 @@ pub struct TimingBudget {
     /// enough for a script that jogs, sleeps a second and stops (pymycobot has no keep-alive),
     /// short enough that a lost link cannot drive a joint far (at most 2 s of motion).
     pub jog_watchdog_us: u64,
-    /// How long a bus reply may wait for a quiet wire before it is dropped (the host resends).
-    pub reply_hold_max_us: u64,
 }
 
 impl Default for TimingBudget {
@@ -138,7 +136,6 @@ impl Default for TimingBudget {
             misses_before_lost: 3,
             interpolation_period_us: 20_000,
             jog_watchdog_us: 2_000_000,
-            reply_hold_max_us: 100_000,
         }
     }
 }

@@ -199,3 +199,71 @@ impl ServoDriver {
         Some((flight.op, outcome))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use protocol_core::NullPort;
+
+    fn start(driver: &mut ServoDriver, op: Op) {
+        let mut rx = BusReceiver::new();
+        assert!(driver.start(0, op, &mut NullPort, &mut rx));
+    }
+
+    fn status(id: u8, data: &[u8]) -> Packet {
+        Packet::new(id, 0, data).unwrap()
+    }
+
+    #[test]
+    fn read_is_answered_only_by_its_servo_with_the_right_length() {
+        let mut d = ServoDriver::new(150);
+        start(
+            &mut d,
+            Op::Read {
+                id: 3,
+                addr: 56,
+                count: 2,
+            },
+        );
+        assert!(!d.start(
+            0,
+            Op::Ping { id: 1 },
+            &mut NullPort,
+            &mut BusReceiver::new()
+        ));
+        assert_eq!(d.on_packet(status(4, &[0, 8])), None, "another servo");
+        assert_eq!(d.on_packet(status(3, &[0])), None, "short answer");
+        let (op, outcome) = d.on_packet(status(3, &[0, 8])).unwrap();
+        assert_eq!(op.id(), 3);
+        assert_eq!(outcome, Outcome::Answered(status(3, &[0, 8])));
+        assert!(!d.busy());
+    }
+
+    #[test]
+    fn silent_servo_times_out_at_the_deadline() {
+        let mut d = ServoDriver::new(150);
+        start(&mut d, Op::Ping { id: 5 });
+        // PING: 6 bytes out (60 us), turnaround 40 us, 6 bytes back (60 us), margin 150 us.
+        assert_eq!(d.poll(309, &NullPort), None);
+        assert_eq!(
+            d.poll(310, &NullPort),
+            Some((Op::Ping { id: 5 }, Outcome::TimedOut))
+        );
+    }
+
+    #[test]
+    fn write_without_answer_is_sent_not_failed_and_broadcast_ends_with_the_transmission() {
+        let mut d = ServoDriver::new(150);
+        start(&mut d, Op::write(2, 40, &[1]).unwrap());
+        assert_eq!(
+            d.poll(1_000, &NullPort).map(|(_, o)| o),
+            Some(Outcome::Sent)
+        );
+        let packet = status(0xFE, &[]);
+        start(&mut d, Op::Broadcast(packet.clone()));
+        assert_eq!(
+            d.poll(0, &NullPort),
+            Some((Op::Broadcast(packet), Outcome::Sent))
+        );
+    }
+}
