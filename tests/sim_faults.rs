@@ -87,7 +87,10 @@ fn a_servo_that_stops_answering_mid_move_is_reported_and_the_rest_carry_on() {
         [status[0], status[1], status[3], status[4], status[5]],
         [0; 5]
     );
-    assert_ne!(status[2], 0, "get_servo_status calls a silent servo healthy");
+    assert_ne!(
+        status[2], 0,
+        "get_servo_status calls a silent servo healthy"
+    );
     let errors = servo_errors(&mut robot);
     assert_eq!(errors[2], ServoErrorCode::NoAnswer.code(), "{errors:?}");
     assert_eq!(
@@ -167,4 +170,25 @@ fn corrupt_answers_are_reported_and_the_host_is_still_served() {
     }
     let errors = servo_errors(&mut robot);
     assert_eq!(errors[5], ServoErrorCode::BadAnswer.code(), "{errors:?}");
+}
+
+#[test]
+fn a_servo_that_browns_out_is_driven_again_by_the_next_move() {
+    let mut robot = arm();
+    start_move(&mut robot);
+    wait_until_stopped(&mut robot);
+    // Joint 2 loses power for a moment under load: it comes back with torque off.
+    robot.servo_mut(2).expect("servo 2").power_cycle();
+    robot.run_for(200_000);
+    let target = degrees([0.0, 10.0, 0.0, 0.0, 0.0, 0.0]);
+    ack(
+        &mut robot,
+        Request::SendAngles {
+            angles: target,
+            speed: speed(100),
+        },
+    );
+    wait_until_stopped(&mut robot);
+    assert_angles_near(robot.measured_angles(), target, "after a servo brown-out");
+    assert!(robot.servo(2).is_some_and(|s| s.torque_enabled()));
 }

@@ -202,14 +202,32 @@ impl SimServo {
         set(reg::HOMING_OFFSET, &0u16.to_le_bytes());
         set(reg::OPERATING_MODE, &[0]);
         set(reg::OVERLOAD_TORQUE, &[80]);
-        set(reg::TORQUE_ENABLE, &[0]);
-        set(reg::ACCELERATION, &[0]);
-        set(reg::TORQUE_LIMIT, &1000u16.to_le_bytes());
-        set(reg::EEPROM_LOCK, &[1]);
         self.table = t;
+        self.reset_ram();
+    }
+
+    /// The RAM part of the table as at power-up: torque off, goal = present position, torque
+    /// limit = max torque (register 16), EEPROM locked.
+    fn reset_ram(&mut self) {
+        for addr in FIRST_RAM_ADDR..reg::PRESENT_POSITION {
+            self.set_reg(addr, 0);
+        }
+        self.set_u16(reg::TORQUE_LIMIT, self.reg_u16(reg::MAX_TORQUE));
+        self.set_reg(reg::EEPROM_LOCK, 1);
+        self.velocity_steps_per_s = 0.0;
         let present = self.present_position();
         self.set_u16(reg::GOAL_POSITION, present);
         self.update_present_registers();
+    }
+
+    /// Switches the servo off and on again (a brown-out under load): the EEPROM part of the
+    /// table and the shaft stay, the RAM part is as at power-up (torque off), and whatever it
+    /// was receiving or about to answer is lost.
+    pub fn power_cycle(&mut self) {
+        self.replies.clear();
+        self.registered = None;
+        self.listener = PacketListener::default();
+        self.reset_ram();
     }
 
     /// The servo's current id (register 5).
@@ -853,6 +871,24 @@ mod tests {
         rig.write(1, reg::TORQUE_ENABLE, &[1]);
         rig.run_for_ms(100);
         assert_eq!(rig.servo(0).present_position(), 1000);
+    }
+
+    #[test]
+    fn a_power_cycle_keeps_the_eeprom_and_drops_torque() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::EEPROM_LOCK, &[0]);
+        rig.write(1, reg::MIN_POSITION, &100u16.to_le_bytes());
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 2500, 0));
+        rig.run_for_ms(300);
+        rig.servo(0).power_cycle();
+        let servo = rig.servo(0);
+        assert!(!servo.torque_enabled());
+        assert_eq!(servo.reg(reg::EEPROM_LOCK), 1);
+        assert_eq!(servo.reg_u16(reg::MIN_POSITION), 100);
+        assert_eq!(servo.present_position(), 2500);
+        assert_eq!(servo.goal_position(), 2500);
+        assert_eq!(servo.reg_u16(reg::TORQUE_LIMIT), 1000);
     }
 
     #[test]
