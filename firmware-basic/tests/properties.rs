@@ -66,13 +66,15 @@ proptest! {
         bus_bytes in stream(),
         steps in prop::collection::vec((0u64..5_000, 0usize..16, any::<bool>()), 1..80),
         echo in echo_mode(),
+        boot_us in prop_oneof![Just(0u64), any::<u64>().prop_map(|t| t / 2)],
     ) {
         let config = BasicConfig { echo, boot_power_on_delay_us: 1_000, ..BasicConfig::default() };
         let mut basic = Basic::new(config);
         let mut host = ScriptPort { rx: host_bytes.into(), idle: true, written: Vec::new() };
         let mut bus = ScriptPort { rx: Default::default(), idle: true, written: Vec::new() };
         let mut bus_src = bus_bytes.into_iter();
-        let mut now = 0u64;
+        // The board's clock may read anything at boot.
+        let mut now = boot_us;
         for (dt, bus_n, idle) in steps {
             now += dt;
             bus.rx.extend(bus_src.by_ref().take(bus_n));
