@@ -97,3 +97,33 @@ fn the_atom_leds_and_pins_do_what_the_host_says() {
         }
     );
 }
+
+#[test]
+fn in_free_mode_the_atom_button_lets_a_hand_pose_the_arm() {
+    let mut robot = arm();
+    ack(&mut robot, Request::SetFreeMode { on: true });
+    assert_eq!(ask(&mut robot, Request::IsFreeMode), Reply::Byte(1));
+    robot.atom_io_mut().button = true;
+    robot.run_for(50_000);
+    assert!(
+        robot.servos().take(6).all(|s| !s.torque_enabled()),
+        "button held: limp"
+    );
+    // The user swings joint 1 to about 30 degrees and lets go of the button.
+    robot
+        .servo_mut(1)
+        .expect("servo 1")
+        .move_by_hand(2048 + 341);
+    robot.run_for(50_000);
+    robot.atom_io_mut().button = false;
+    robot.run_for(200_000);
+    assert!(
+        robot.servos().take(6).all(|s| s.torque_enabled()),
+        "released: holding"
+    );
+    let posed = robot.measured_angles();
+    assert!((posed[0].0 - 3_000).abs() <= ANGLE_TOLERANCE, "{posed:?}");
+    robot.run_for(1_000_000);
+    assert_eq!(robot.measured_angles(), posed, "the arm holds the pose");
+    assert_angles_near(get_angles(&mut robot), posed, "get_angles");
+}
