@@ -578,7 +578,8 @@ fn servo_errors(atom: &Atom) -> [u8; SERVOS] {
 
 impl Atom {
     /// Writes a servo register for 0x52. EEPROM registers are unlocked and locked around the
-    /// write. A write touching the goal position is a motion and goes through the choke point.
+    /// write. A write touching the goal position is a motion and goes through the choke point;
+    /// torque writes go through the torque bookkeeping; id and baud rate are refused.
     fn write_register(
         &mut self,
         index: usize,
@@ -595,6 +596,24 @@ impl Atom {
             ServoValue::Word(w) => (w.to_le_bytes(), 2),
         };
         let touches = |r: u8| addr <= r && r < addr.saturating_add(len);
+        // Changing a servo's id or baud rate takes it off the arm's bus for good.
+        if touches(reg::ID) || touches(reg::BAUD_RATE) {
+            return Err(ActionError::Invalid);
+        }
+        // Torque 128 is the calibration: same bookkeeping as 0x54.
+        if addr == reg::TORQUE_ENABLE && value == ServoValue::Byte(128) {
+            return self.calibrate(index);
+        }
+        // Any other torque write is torque on/off, with the hold goal a torque-on needs.
+        if addr == reg::TORQUE_ENABLE
+            && let ServoValue::Byte(b) = value
+        {
+            return if self.set_torque(index, b != 0) {
+                Ok(())
+            } else {
+                Err(ActionError::Invalid)
+            };
+        }
         if touches(reg::GOAL_POSITION) || touches(reg::GOAL_POSITION + 1) {
             return match value {
                 ServoValue::Word(w) if addr == reg::GOAL_POSITION => {
@@ -621,11 +640,6 @@ impl Atom {
         self.queue_op(write, Then::Nothing);
         if eeprom && let Some(lock) = Op::write(id, reg::EEPROM_LOCK, &[1]) {
             self.queue_op(lock, Then::Nothing);
-        }
-        if addr == reg::TORQUE_ENABLE
-            && let (Some(h), Some(&b)) = (self.health.get_mut(index), data.first())
-        {
-            h.torque_on = b != 0;
         }
         Ok(())
     }

@@ -14,8 +14,14 @@
 //!   0x07 (1..6 joint limit, 32 unreachable pose, 33/34 linear move). Invalid frames (unknown
 //!   code, wrong length, value out of range) answer `00`.
 //! * **State** (angles, coords, encoders, speeds, voltages, temperatures, faults) comes from
-//!   the servos: every servo's 15-byte state block is read in turn, about 280 rounds per second
-//!   (bench `latency`). Coordinates are the forward kinematics of the present angles.
+//!   the servos: registers 40..=70 of every servo are read in turn (one READ each), about 225
+//!   rounds per second (bench `latency`). Coordinates are the forward kinematics of the present
+//!   angles. The same read gives back each servo's torque and goal registers: a goal or torque
+//!   write lost on the shared wire (a SYNC WRITE has no answer) is re-sent, at most 3 times per
+//!   command.
+//! * **Shared wire.** Host replies go out in the gap between servo transactions; a reply whose
+//!   echo comes back garbled (collision) is sent again once the wire is quiet, up to twice, so
+//!   the host never has to resend (and never repeats an incremental jog).
 //! * **Safety.** Every position goal passes one check ([`safety::check`]): power on, joint
 //!   limits (settable with 0x4C/0x4D), encoder range. No path bypasses it.
 //! * **Motion.** Joint moves scale each joint's speed and ramp by its share of the longest
@@ -30,8 +36,10 @@
 //!   range [`config::GripperRange`] (default 2048 ..= 3072); calibration (0x68) makes the
 //!   present position the new closed end (the servo's present position becomes 2048).
 //! * **Servo health.** A servo that misses 3 state reads in a row is reported not answering
-//!   (0x50, 0x51, 0x15 code 16) and then probed only every 8th round, so it costs the others
-//!   almost nothing; fault bits show in 0xE4 and 0x15 (32 + bits).
+//!   (0x50, 0x51, 0xE4 reads 0xFF, 0x15 code 16, or 17 when its answers are corrupt) and then
+//!   probed only every 8th round, so it costs the others almost nothing; fault bits show in
+//!   0xE4 and 0x15 (32 + bits). Raw register writes (0x52) may not change a servo's id or baud
+//!   rate; EEPROM registers are unlocked and locked around the write.
 //! * **Free mode** (0x1A 1): holding the Atom's button releases the joints so the arm can be
 //!   moved by hand; letting go holds it where it is.
 #![cfg_attr(not(test), no_std)]

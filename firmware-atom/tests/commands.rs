@@ -261,6 +261,10 @@ fn servo_data_read_and_eeprom_write() {
     rig.run_ms(10);
     assert_eq!(rig.bus.servo(3).table[21], 40);
     assert_eq!(rig.bus.servo(3).table[55], 1, "EEPROM locked again");
+    // The id and baud rate are refused (the servo would leave the arm's bus).
+    assert_eq!(rig.ask(0x52, &[3, 5, 9]), [0]);
+    rig.run_ms(10);
+    assert_eq!(rig.bus.servo(3).table[5], 3);
     // A raw write to the goal register goes through the limits.
     let mut goal = vec![1, 42];
     goal.extend(be(&[4095]));
