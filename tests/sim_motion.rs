@@ -234,3 +234,31 @@ fn requests_sent_back_to_back_are_answered_in_order() {
         vec![cmd::GET_ANGLES, cmd::IS_POWER_ON, cmd::GET_ENCODERS]
     );
 }
+
+#[test]
+fn powering_on_after_hand_posing_holds_the_new_pose() {
+    use protocol_core::command::ServoSelect;
+    for hold in [
+        Request::PowerOn,
+        Request::FocusServo {
+            servo: ServoSelect::All,
+        },
+    ] {
+        let mut robot = arm();
+        ack(&mut robot, Request::ReleaseAllServos { undamped: None });
+        robot.run_for(20_000);
+        robot
+            .servo_mut(3)
+            .expect("servo 3")
+            .move_by_hand(2048 - 341);
+        robot.run_for(100_000);
+        let posed = robot.measured_angles();
+        ack(&mut robot, hold.clone());
+        robot.run_for(1_000_000);
+        assert!(
+            robot.servos().take(6).all(|s| s.torque_enabled()),
+            "{hold:?}"
+        );
+        assert_eq!(robot.measured_angles(), posed, "{hold:?} moved the arm");
+    }
+}
