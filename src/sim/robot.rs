@@ -214,7 +214,7 @@ impl VirtualRobot {
                 servo: SimServo::new(id, config.initial_position_steps),
             })
             .collect();
-        let noise_station = bus.attach(false);
+        let noise_station = bus.attach_transmitter();
         bus.set_tap(true);
         Self {
             now_ns: 0,
