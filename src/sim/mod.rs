@@ -7,6 +7,21 @@
 //! * [`VirtualRobot`]: the real `firmware_basic::Basic` and `firmware_atom::Atom` wired to seven
 //!   servos; time advances only in [`VirtualRobot::run_until`], as fast as the host can.
 //!
+//! What a test or a tool can do with it:
+//!
+//! * talk like a host: [`VirtualRobot::host_write`] / [`VirtualRobot::host_read`] (the Basic's
+//!   USB), [`VirtualRobot::link_write`] / [`VirtualRobot::link_read`] (either board's USB),
+//!   or one request at a time with [`VirtualRobot::ask`], [`VirtualRobot::transact`] and
+//!   [`VirtualRobot::await_frame`];
+//! * drive it in real time: call [`VirtualRobot::run_until`] with the wall clock;
+//! * break things: [`SimServo::set_faults`] (no answer, bad checksum, stall, overheat),
+//!   [`SimServo::power_cycle`], [`SimServo::move_by_hand`], [`VirtualRobot::inject_bus_noise`],
+//!   [`VirtualRobot::reset_atom`], [`VirtualRobot::reset_basic`], and [`RobotConfig`] for echo
+//!   wiring, a robot without a Basic, and the firmware configurations;
+//! * look: [`VirtualRobot::measured_angles`] (where the shafts really are), the servos' tables
+//!   and [`ServoStats`], and every byte on the bus with its sender and times
+//!   ([`Bus::set_tracing`], [`Bus::take_trace`]).
+//!
 //! ```
 //! use open_mycobot::sim::{RobotConfig, VirtualRobot};
 //!
