@@ -6,29 +6,34 @@
 //! starts holds the schedule until it ends, and its reply goes out at once (from cached
 //! state), before the next transaction. Transactions, by priority: servo operations of host
 //! commands (torque, calibration, register access), then the newest goals, then the state
-//! refresh, which reads the 15-byte state block of each servo in turn (one READ per servo, so
-//! a missing servo costs only its own timeout). After every non-refresh transaction one refresh
+//! refresh, which reads registers 40..=70 of each servo in turn (one READ per servo, so a
+//! missing servo costs only its own timeout; [`readback`]). After every non-refresh transaction one refresh
 //! read runs, so host traffic cannot starve the state refresh.
+//!
+//! Straight-line moves and Cartesian jogs are stepped by [`stepper`].
 
 use heapless::Deque;
-use protocol_core::servo::{Packet, reg, sign_magnitude};
+use protocol_core::servo::reg;
 use protocol_core::timing::{
     ATOM_TRANSACTION_GAP_US, BUS_BAUD, BUS_QUIET_BEFORE_SEND_US, HOST_FRAME_GAP_US, wire_time_us,
 };
 use protocol_core::units::{Centideg, Steps};
 use protocol_core::{BytePort, Frame, FrameDecoder};
 
-use kinematics_core::LinearPath;
-use protocol_core::command::{MoveMode, Pose};
-
 use crate::bus::{BusEvent, BusReceiver};
-use crate::cartesian::{self, Cartesian};
+use crate::cartesian::Cartesian;
 use crate::config::{AtomConfig, ConfigError, GRIPPER, JOINTS, JointLimit, SERVOS};
 use crate::driver::{Op, Outcome, ServoDriver};
 use crate::health::ServoHealth;
 use crate::io::AtomIo;
 use crate::motion::{self, Activity, JogDirection};
 use crate::safety::{self, Goal, GoalSet, Refusal};
+
+mod readback;
+mod stepper;
+
+use readback::{STATE_READ_ADDR, STATE_READ_LEN, apply_state};
+use stepper::Stepper;
 
 /// Servo operations waiting for the bus. 16: a command queues at most 3 (EEPROM unlock,
 /// write, lock) or 7 (torque on/off for every servo), and the host waits for each reply.
@@ -41,22 +46,6 @@ const MOTION_QUEUE: usize = 16;
 /// A servo that stopped answering is probed only every this many refresh rounds, so a missing
 /// servo (often the gripper) does not cost its timeout in every round.
 const LOST_SERVO_PROBE_ROUNDS: u32 = 8;
-
-/// Acceleration register of the fastest joint during stepped (linear, jog) motion: 254 x 100
-/// steps/s^2, the servo reaches full joint speed in under 70 ms.
-const STEP_ACCEL_REGISTER: u8 = 254;
-
-/// First register of the state read: torque enable (40) through present current (69..70), so
-/// one READ per servo confirms torque and goal as well as the present state. 31 bytes: a
-/// transaction of about 0.5 ms, a full round of seven servos in about 4 ms (250 Hz).
-const STATE_READ_ADDR: u8 = reg::TORQUE_ENABLE;
-/// Length of the state read (registers 40..=70).
-const STATE_READ_LEN: u8 = reg::PRESENT_CURRENT + 2 - reg::TORQUE_ENABLE;
-
-/// Corrective writes per servo and command when the read-back disagrees (a lost write is
-/// re-sent; a servo that keeps disagreeing, e.g. a goal clamped by its own position limits, is
-/// left alone after this many).
-const MAX_REPAIRS: u8 = 3;
 
 /// Speed at which a servo switched on outside its joint limits is pulled back inside: 10 %.
 const HOLD_SPEED_PERCENT: u8 = 10;
@@ -216,31 +205,6 @@ pub struct Atom {
     pub(crate) cart: Cartesian,
     /// A straight-line move or a Cartesian jog being stepped.
     stepper: Option<Stepper>,
-}
-
-/// A motion stepped in Cartesian space every interpolation period.
-// One instance lives inside the Atom (no allocation to box into), so the size of the larger
-// variant costs nothing extra.
-#[allow(clippy::large_enum_variant)]
-#[derive(Clone, Debug)]
-enum Stepper {
-    /// A straight line (send coords mode 1).
-    Line {
-        path: LinearPath,
-        next_us: u64,
-        target: Pose,
-        speed_percent: u8,
-    },
-    /// A continuous Cartesian jog: axis 0..2 = x, y, z, 3..5 = rotation about base x, y, z.
-    Jog {
-        axis: usize,
-        direction: JogDirection,
-        speed_percent: u8,
-        next_us: u64,
-        /// The joint angles last commanded (the next step starts from here, not from the
-        /// lagging present position).
-        angles: [Centideg; JOINTS],
-    },
 }
 
 impl Atom {
@@ -945,6 +909,11 @@ impl Atom {
         self.button_was_pressed = pressed;
     }
 
+    /// Forgets queued motions (0x05); the current one continues.
+    pub(crate) fn clear_queue(&mut self) {
+        self.queue.clear();
+    }
+
     /// Records a failure's error code for 0x07.
     pub(crate) fn record(&mut self, e: ActionError) {
         if let Some(code) = e.error_code() {
@@ -1056,314 +1025,5 @@ impl Atom {
             return 0;
         }
         ((pos - closed) * 100 / span).clamp(0, 100) as u8
-    }
-}
-
-/// Applies a state read (registers 40..=70) to a servo's health.
-fn apply_state(h: &mut ServoHealth, p: &Packet) {
-    let at = |addr: u8| usize::from(addr - STATE_READ_ADDR);
-    let byte = |addr: u8| p.params().get(at(addr)).copied().unwrap_or(0);
-    let word = |addr: u8| p.u16_at(at(addr)).unwrap_or(0);
-    h.answering = true;
-    h.ever_answered = true;
-    h.misses = 0;
-    h.corrupt_answers = false;
-    h.position = Steps(sign_magnitude(word(reg::PRESENT_POSITION), 15));
-    h.speed_steps_per_s = sign_magnitude(word(reg::PRESENT_SPEED), 15);
-    h.load_permille = sign_magnitude(word(reg::PRESENT_LOAD), 10);
-    h.voltage_decivolt = byte(reg::PRESENT_VOLTAGE);
-    h.temperature_c = byte(reg::PRESENT_TEMPERATURE);
-    h.fault_bits = p.code() | byte(reg::STATUS);
-    h.moving = byte(reg::MOVING) != 0;
-    h.current_raw = sign_magnitude(word(reg::PRESENT_CURRENT), 15);
-    h.torque_reported = byte(reg::TORQUE_ENABLE) != 0;
-    h.goal_reported = Steps(sign_magnitude(word(reg::GOAL_POSITION), 15));
-}
-
-impl Atom {
-    /// Compares what servo `index` reports with what it was told (torque, goal) and re-sends
-    /// what got lost: a SYNC WRITE has no answer, and a collision on the shared wire can
-    /// swallow it or a torque write. At most [`MAX_REPAIRS`] corrections per command, and
-    /// none while a command for that servo is still on its way.
-    fn verify(&mut self, index: usize) {
-        let Some(&id) = self.config.servo_ids.get(index) else {
-            return;
-        };
-        let Some(h) = self.health.get(index).copied() else {
-            return;
-        };
-        let pending_goal = self
-            .pending_goals
-            .as_ref()
-            .is_some_and(|p| p.goals().get(index).copied().flatten().is_some());
-        let pending_job = self.jobs.iter().any(|j| j.op.id() == id);
-        let repairs = self.repairs.get(index).copied().unwrap_or(MAX_REPAIRS);
-        if pending_goal || pending_job || repairs >= MAX_REPAIRS {
-            return;
-        }
-        if h.torque_reported != h.torque_on {
-            let op = if h.torque_on {
-                self.torque_on_op(index, id)
-            } else {
-                Op::write(id, reg::TORQUE_ENABLE, &[0])
-            };
-            if let Some(op) = op {
-                self.queue_op(op, Then::Nothing);
-            }
-        } else if h.torque_on
-            && let Some(goal) = self.last_goal.get(index).copied().flatten()
-            && (i32::from(goal.position.0) - i32::from(h.goal_reported.0)).abs() > 1
-        {
-            let mut merged: GoalSet = self
-                .pending_goals
-                .as_ref()
-                .map(|p| *p.goals())
-                .unwrap_or([None; SERVOS]);
-            if let Some(slot) = merged.get_mut(index) {
-                *slot = Some(goal);
-            }
-            // Through the choke point again: the limits may have changed since.
-            match safety::check(&self.config, &self.limits, self.powered, merged) {
-                Ok(safe) => self.pending_goals = Some(safe),
-                Err(_) => return,
-            }
-        } else {
-            return;
-        }
-        if let Some(r) = self.repairs.get_mut(index) {
-            *r += 1;
-        }
-    }
-}
-
-impl Atom {
-    /// Forgets queued motions (0x05); the current one continues.
-    pub(crate) fn clear_queue(&mut self) {
-        self.queue.clear();
-    }
-
-    /// The end pose at the present joint angles.
-    pub(crate) fn present_coords(&mut self) -> Pose {
-        let angles = self.present_angles();
-        self.cart.forward(&angles)
-    }
-
-    /// The end pose of the target being executed (present pose when idle).
-    pub(crate) fn planned_coords(&mut self) -> Pose {
-        if let Some(Stepper::Line { target, .. }) = &self.stepper {
-            return *target;
-        }
-        let angles = self.planned_angles();
-        self.cart.forward(&angles)
-    }
-
-    /// Moves the end to `pose`: joint-interpolated (mode 0) or along a straight line (mode 1).
-    pub(crate) fn move_to_pose(
-        &mut self,
-        now_us: u64,
-        pose: Pose,
-        speed_percent: u8,
-        mode: MoveMode,
-    ) -> Result<(), ActionError> {
-        if !self.powered {
-            return Err(ActionError::PoweredOff);
-        }
-        let seed = self.planned_angles();
-        let angles = self
-            .cart
-            .inverse(&pose, &seed)
-            .map_err(|_| ActionError::Unreachable)?;
-        let target = Target {
-            angles: angles.map(Some),
-            speed_percent,
-        };
-        self.check_target(&target)?;
-        if mode == MoveMode::Joint || !self.fresh_mode && self.activity != Activity::Idle {
-            return self.submit_motion(now_us, target);
-        }
-        let start = cartesian::joints(&self.present_angles());
-        let step = self.linear_step_decimm(speed_percent);
-        let path = LinearPath::new(self.cart.model(), &start, &cartesian::to_kin(&pose), step)
-            .map_err(|_| ActionError::Unreachable)?;
-        self.queue.clear();
-        self.paused = None;
-        self.stepper = Some(Stepper::Line {
-            path,
-            next_us: now_us,
-            target: pose,
-            speed_percent,
-        });
-        self.activity = Activity::Moving {
-            target: angles,
-            started_us: now_us,
-            duration_us: u64::MAX / 4,
-            jog: false,
-        };
-        Ok(())
-    }
-
-    /// Distance covered in one interpolation period at `speed_percent`, tenth-millimetres.
-    fn linear_step_decimm(&self, speed_percent: u8) -> i32 {
-        let v = u64::from(self.config.motion.linear_speed_decimm_per_s)
-            * u64::from(speed_percent.clamp(1, 100))
-            / 100;
-        (v * self.config.timing.interpolation_period_us / 1_000_000).max(1) as i32
-    }
-
-    /// Starts a continuous Cartesian jog (0x31, 0x32): `axis` 0..2 along x, y, z, 3..5 about
-    /// the base x, y, z axes.
-    pub(crate) fn jog_pose(
-        &mut self,
-        now_us: u64,
-        axis: usize,
-        direction: JogDirection,
-        speed_percent: u8,
-    ) -> Result<(), ActionError> {
-        if !self.powered {
-            return Err(ActionError::PoweredOff);
-        }
-        self.halt(true);
-        self.stepper = Some(Stepper::Jog {
-            axis,
-            direction,
-            speed_percent,
-            next_us: now_us,
-            angles: self.present_angles(),
-        });
-        self.activity = Activity::Moving {
-            target: self.present_angles(),
-            started_us: now_us,
-            duration_us: u64::MAX / 4,
-            jog: true,
-        };
-        Ok(())
-    }
-
-    /// Takes the next step of a straight line or Cartesian jog when it is due.
-    fn update_stepper(&mut self, now_us: u64) {
-        let period = self.config.timing.interpolation_period_us;
-        let Some(stepper) = self.stepper.as_mut() else {
-            return;
-        };
-        let speed_percent = match stepper {
-            Stepper::Line { speed_percent, .. } | Stepper::Jog { speed_percent, .. } => {
-                *speed_percent
-            }
-        };
-        let next_angles = match stepper {
-            Stepper::Line { path, next_us, .. } => {
-                if now_us < *next_us {
-                    return;
-                }
-                *next_us = now_us + period;
-                match path.next(self.cart.model()) {
-                    None => {
-                        // Last step sent: the move ends when the joints arrive.
-                        self.stepper = None;
-                        return;
-                    }
-                    Some(Err(e)) => Err(if e.protocol_code() == 33 {
-                        ActionError::NoLinearSolution
-                    } else {
-                        ActionError::Unreachable
-                    }),
-                    Some(Ok(q)) => Ok(cartesian::angles(&q)),
-                }
-            }
-            Stepper::Jog {
-                axis,
-                direction,
-                speed_percent,
-                next_us,
-                angles,
-            } => {
-                if now_us < *next_us {
-                    return;
-                }
-                *next_us = now_us + period;
-                let (axis, sign, pct, from) = (*axis, direction.sign(), *speed_percent, *angles);
-                let pose = self.cart.forward(&from);
-                let target = if axis < 3 {
-                    let step = self.linear_step_decimm(pct) * sign;
-                    let mut a = pose.to_array();
-                    if let Some(v) = a.get_mut(axis) {
-                        *v = (i32::from(*v) + step).clamp(-32_768, 32_767) as i16;
-                    }
-                    Pose::from_array(a)
-                } else {
-                    let v = u64::from(self.config.motion.rotation_speed_centideg_per_s)
-                        * u64::from(pct.clamp(1, 100))
-                        / 100;
-                    let step = (v * period / 1_000_000).max(1) as i32 * sign;
-                    self.cart
-                        .rotate_about_base(&pose, axis - 3, Centideg(step as i16))
-                };
-                self.cart
-                    .inverse(&target, &from)
-                    .map_err(|_| ActionError::Unreachable)
-            }
-        };
-        match next_angles.and_then(|q| self.step_to(&q, period, speed_percent)) {
-            Ok(q) => {
-                if let Some(Stepper::Jog { angles, .. }) = self.stepper.as_mut() {
-                    *angles = q;
-                }
-            }
-            Err(e) => {
-                self.record(e);
-                self.halt(true);
-            }
-        }
-    }
-
-    /// Sends goals that reach joint angles `q` in one interpolation period, no joint faster
-    /// than the joint speed at `speed_percent` (a long step then takes longer than a period).
-    fn step_to(
-        &mut self,
-        q: &[Centideg; JOINTS],
-        period_us: u64,
-        speed_percent: u8,
-    ) -> Result<[Centideg; JOINTS], ActionError> {
-        self.check_target(&Target {
-            angles: q.map(Some),
-            speed_percent: 100,
-        })?;
-        let present = self.present_steps();
-        let max_speed = u64::from(motion::joint_speed_steps(&self.config, speed_percent));
-        let goal_steps: [Steps; JOINTS] = core::array::from_fn(|j| {
-            self.config
-                .angle_to_steps(j, q.get(j).copied().unwrap_or_default())
-        });
-        let travel = |j: usize| -> u64 {
-            match (goal_steps.get(j), present.get(j)) {
-                (Some(g), Some(p)) => u64::from((i32::from(g.0) - i32::from(p.0)).unsigned_abs()),
-                _ => 0,
-            }
-        };
-        // The step takes one period, or longer if the farthest joint cannot make it in time;
-        // every joint's speed is scaled to that time so all arrive together.
-        let longest = (0..JOINTS).map(travel).max().unwrap_or(0);
-        let step_us = (longest * 1_000_000 / max_speed.max(1)).max(period_us.max(1));
-        let mut goals: GoalSet = [None; SERVOS];
-        for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
-            let speed = (travel(j) * 1_000_000 / step_us).clamp(1, max_speed.max(1));
-            // Steps need a brisk ramp (the servo must reach the step speed within a fraction
-            // of a period), scaled by the joint's share like the speed, so every joint follows
-            // the same time-scaled profile and the end stays on the line.
-            let accel = (u64::from(STEP_ACCEL_REGISTER) * travel(j) / longest.max(1)).max(1);
-            *slot = goal_steps.get(j).map(|&position| Goal {
-                position,
-                speed_steps_per_s: speed.min(u64::from(u16::MAX)) as u16,
-                accel: accel.min(254) as u8,
-            });
-        }
-        self.send_goals(goals)?;
-        if let Activity::Moving {
-            target, jog: true, ..
-        } = &mut self.activity
-        {
-            *target = *q;
-        }
-        Ok(*q)
     }
 }

@@ -1,0 +1,99 @@
+//! The state read of every servo, and the repair of writes lost on the shared wire.
+
+use protocol_core::servo::{Packet, reg, sign_magnitude};
+use protocol_core::units::Steps;
+
+use super::{Atom, Then};
+use crate::config::SERVOS;
+use crate::driver::Op;
+use crate::health::ServoHealth;
+use crate::safety::{self, GoalSet};
+
+/// First register of the state read: torque enable (40) through present current (69..70), so
+/// one READ per servo confirms torque and goal as well as the present state. 31 bytes: a
+/// transaction of about 0.5 ms, a full round of seven servos in about 4 ms (250 Hz).
+pub(super) const STATE_READ_ADDR: u8 = reg::TORQUE_ENABLE;
+/// Length of the state read (registers 40..=70).
+pub(super) const STATE_READ_LEN: u8 = reg::PRESENT_CURRENT + 2 - reg::TORQUE_ENABLE;
+
+/// Corrective writes per servo and command when the read-back disagrees (a lost write is
+/// re-sent; a servo that keeps disagreeing, e.g. a goal clamped by its own position limits, is
+/// left alone after this many).
+const MAX_REPAIRS: u8 = 3;
+
+/// Applies a state read (registers 40..=70) to a servo's health.
+pub(super) fn apply_state(h: &mut ServoHealth, p: &Packet) {
+    let at = |addr: u8| usize::from(addr - STATE_READ_ADDR);
+    let byte = |addr: u8| p.params().get(at(addr)).copied().unwrap_or(0);
+    let word = |addr: u8| p.u16_at(at(addr)).unwrap_or(0);
+    h.answering = true;
+    h.ever_answered = true;
+    h.misses = 0;
+    h.corrupt_answers = false;
+    h.position = Steps(sign_magnitude(word(reg::PRESENT_POSITION), 15));
+    h.speed_steps_per_s = sign_magnitude(word(reg::PRESENT_SPEED), 15);
+    h.load_permille = sign_magnitude(word(reg::PRESENT_LOAD), 10);
+    h.voltage_decivolt = byte(reg::PRESENT_VOLTAGE);
+    h.temperature_c = byte(reg::PRESENT_TEMPERATURE);
+    h.fault_bits = p.code() | byte(reg::STATUS);
+    h.moving = byte(reg::MOVING) != 0;
+    h.current_raw = sign_magnitude(word(reg::PRESENT_CURRENT), 15);
+    h.torque_reported = byte(reg::TORQUE_ENABLE) != 0;
+    h.goal_reported = Steps(sign_magnitude(word(reg::GOAL_POSITION), 15));
+}
+
+impl Atom {
+    /// Compares what servo `index` reports with what it was told (torque, goal) and re-sends
+    /// what got lost: a SYNC WRITE has no answer, and a collision on the shared wire can
+    /// swallow it or a torque write. At most [`MAX_REPAIRS`] corrections per command, and
+    /// none while a command for that servo is still on its way.
+    pub(super) fn verify(&mut self, index: usize) {
+        let Some(&id) = self.config.servo_ids.get(index) else {
+            return;
+        };
+        let Some(h) = self.health.get(index).copied() else {
+            return;
+        };
+        let pending_goal = self
+            .pending_goals
+            .as_ref()
+            .is_some_and(|p| p.goals().get(index).copied().flatten().is_some());
+        let pending_job = self.jobs.iter().any(|j| j.op.id() == id);
+        let repairs = self.repairs.get(index).copied().unwrap_or(MAX_REPAIRS);
+        if pending_goal || pending_job || repairs >= MAX_REPAIRS {
+            return;
+        }
+        if h.torque_reported != h.torque_on {
+            let op = if h.torque_on {
+                self.torque_on_op(index, id)
+            } else {
+                Op::write(id, reg::TORQUE_ENABLE, &[0])
+            };
+            if let Some(op) = op {
+                self.queue_op(op, Then::Nothing);
+            }
+        } else if h.torque_on
+            && let Some(goal) = self.last_goal.get(index).copied().flatten()
+            && (i32::from(goal.position.0) - i32::from(h.goal_reported.0)).abs() > 1
+        {
+            let mut merged: GoalSet = self
+                .pending_goals
+                .as_ref()
+                .map(|p| *p.goals())
+                .unwrap_or([None; SERVOS]);
+            if let Some(slot) = merged.get_mut(index) {
+                *slot = Some(goal);
+            }
+            // Through the choke point again: the limits may have changed since.
+            match safety::check(&self.config, &self.limits, self.powered, merged) {
+                Ok(safe) => self.pending_goals = Some(safe),
+                Err(_) => return,
+            }
+        } else {
+            return;
+        }
+        if let Some(r) = self.repairs.get_mut(index) {
+            *r += 1;
+        }
+    }
+}
