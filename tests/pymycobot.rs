@@ -7,14 +7,17 @@
 //! Python or a failed install fails the test with the reason.
 
 use std::fs::{self, File};
-use std::io::{BufRead, BufReader, Read};
+use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdout, Command, ExitStatus, Stdio};
+use std::process::{Command, Stdio};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use nix::sys::signal::{Signal, kill};
-use nix::unistd::Pid;
+use nix::sys::signal::Signal;
+
+#[path = "e2e/launcher.rs"]
+mod launcher;
+use launcher::{Launched, launch};
 
 const PYMYCOBOT: &str = "pymycobot==4.0.7";
 /// The whole Python suite must finish within this (it runs in real time; ~2 min expected).
@@ -75,10 +78,9 @@ fn run_checked(command: &mut Command) {
     );
 }
 
-/// The running virtual robot; stopped with SIGTERM (a clean stop) when dropped.
+/// The robot for the suite: a pty link in the temp dir, TCP on a free port.
 struct Robot {
-    child: Child,
-    _stdout: BufReader<ChildStdout>,
+    launched: Launched,
     link: PathBuf,
     tcp: String,
 }
@@ -86,62 +88,16 @@ struct Robot {
 impl Robot {
     fn start() -> Robot {
         let link = std::env::temp_dir().join(format!("open-mycobot-e2e-{}", std::process::id()));
-        let mut child = Command::new(env!("CARGO_BIN_EXE_open-mycobot"))
-            .arg("--pty-link")
-            .arg(&link)
-            .args(["--tcp", "127.0.0.1:0"])
-            .stdout(Stdio::piped())
-            .spawn()
-            .expect("start the virtual robot");
-        let mut stdout = BufReader::new(child.stdout.take().expect("piped stdout"));
-        let mut tcp = None;
-        let mut banner = String::new();
-        loop {
-            let mut line = String::new();
-            let read = stdout
-                .read_line(&mut line)
-                .expect("read the robot's banner");
-            banner.push_str(&line);
-            if read == 0 {
-                let _ = child.kill();
-                panic!("the robot exited during start-up:\n{banner}");
-            }
-            if let Some(addr) = line.trim().strip_prefix("tcp on ") {
-                tcp = Some(addr.to_string());
-            }
-            if line.starts_with("ready") {
-                break;
-            }
-        }
+        let link_arg = link.to_str().expect("temp dir path is UTF-8");
+        let launched = launch(&["--pty-link", link_arg, "--tcp", "127.0.0.1:0"]);
+        let tcp = launched
+            .banner_value("tcp on ")
+            .unwrap_or_else(|| panic!("no TCP address in the banner:\n{}", launched.banner))
+            .to_string();
         Robot {
-            child,
-            _stdout: stdout,
+            launched,
             link,
-            tcp: tcp.unwrap_or_else(|| panic!("no TCP address in the banner:\n{banner}")),
-        }
-    }
-
-    /// Sends SIGTERM and waits up to 5 s; returns how it exited.
-    fn stop(&mut self) -> Option<ExitStatus> {
-        let pid = Pid::from_raw(i32::try_from(self.child.id()).ok()?);
-        let _ = kill(pid, Signal::SIGTERM);
-        let deadline = Instant::now() + Duration::from_secs(5);
-        while Instant::now() < deadline {
-            if let Ok(Some(status)) = self.child.try_wait() {
-                return Some(status);
-            }
-            thread::sleep(Duration::from_millis(20));
-        }
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-        None
-    }
-}
-
-impl Drop for Robot {
-    fn drop(&mut self) {
-        if matches!(self.child.try_wait(), Ok(None)) {
-            self.stop();
+            tcp,
         }
     }
 }
@@ -212,7 +168,7 @@ fn pymycobot_end_to_end_suite() {
 
     let (passed, output) = run_suite(&python, &robot);
 
-    let exit = robot.stop();
+    let exit = robot.launched.stop_with(Signal::SIGTERM);
     let link_left = fs::symlink_metadata(&robot.link).is_ok();
     assert!(passed, "pymycobot end-to-end suite failed:\n{output}");
     println!("{output}");

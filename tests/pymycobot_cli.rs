@@ -3,21 +3,20 @@
 //! Speaks raw frames on the pseudo-terminal, so it needs no Python.
 
 use std::fs::{self, OpenOptions};
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::net::TcpListener;
 use std::os::unix::fs::symlink;
 use std::path::PathBuf;
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Command, Output};
 use std::sync::mpsc;
 use std::thread;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use nix::sys::signal::{Signal, kill};
-use nix::unistd::Pid;
+use nix::sys::signal::Signal;
 
-fn robot() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_open-mycobot"))
-}
+#[path = "e2e/launcher.rs"]
+mod launcher;
+use launcher::launch;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-{name}"));
@@ -26,41 +25,11 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// Starts the robot and reads its banner up to "ready"; returns the child and the banner.
-fn start(args: &[&str]) -> (Child, String) {
-    let mut child = robot().args(args).stdout(Stdio::piped()).spawn().unwrap();
-    let mut stdout = BufReader::new(child.stdout.take().unwrap());
-    let mut banner = String::new();
-    while !banner.contains("ready") {
-        let mut line = String::new();
-        if stdout.read_line(&mut line).unwrap() == 0 {
-            panic!("the robot exited during start-up: {banner}");
-        }
-        banner.push_str(&line);
-    }
-    // Keep draining stdout so the final "stopped" line never hits a closed pipe.
-    thread::spawn(move || {
-        let mut rest = String::new();
-        let _ = stdout.read_to_string(&mut rest);
-    });
-    (child, banner)
-}
-
-fn signal_and_wait(child: &mut Child, signal: Signal) -> bool {
-    kill(Pid::from_raw(child.id() as i32), signal).unwrap();
-    let deadline = Instant::now() + Duration::from_secs(5);
-    while Instant::now() < deadline {
-        if let Some(status) = child.try_wait().unwrap() {
-            return status.success();
-        }
-        thread::sleep(Duration::from_millis(20));
-    }
-    let _ = child.kill();
-    panic!("the robot did not stop within 5 s of {signal:?}");
-}
-
 fn run_to_end(args: &[&str]) -> Output {
-    robot().args(args).output().unwrap()
+    Command::new(env!("CARGO_BIN_EXE_open-mycobot"))
+        .args(args)
+        .output()
+        .unwrap()
 }
 
 #[test]
@@ -69,11 +38,10 @@ fn serves_the_link_replaces_a_stale_one_and_removes_it_on_ctrl_c() {
     let link = dir.join("mycobot");
     symlink("/dev/pts/stale-from-a-killed-run", &link).unwrap();
 
-    let (mut child, banner) = start(&["--pty-link", link.to_str().unwrap()]);
-    let pts = banner
-        .lines()
-        .find_map(|l| l.strip_prefix("virtual myCobot 280 on "))
-        .unwrap_or_else(|| panic!("no pty path in the banner: {banner}"));
+    let mut robot = launch(&["--pty-link", link.to_str().unwrap()]);
+    let pts = robot
+        .banner_value("virtual myCobot 280 on ")
+        .unwrap_or_else(|| panic!("no pty path in the banner: {}", robot.banner));
     assert_eq!(fs::read_link(&link).unwrap(), PathBuf::from(pts));
 
     // Through the link, a raw is_power_on request gets the answer "powered on".
@@ -93,7 +61,11 @@ fn serves_the_link_replaces_a_stale_one_and_removes_it_on_ctrl_c() {
         .expect("no reply within 5 s");
     assert_eq!(reply.unwrap(), [0xFE, 0xFE, 0x03, 0x12, 0x01, 0xFA]);
 
-    assert!(signal_and_wait(&mut child, Signal::SIGINT), "exit status");
+    let exit = robot.stop_with(Signal::SIGINT);
+    assert!(
+        exit.is_some_and(|s| s.success()),
+        "exit after Ctrl-C: {exit:?}"
+    );
     assert!(
         fs::symlink_metadata(&link).is_err(),
         "link left behind after Ctrl-C"
