@@ -126,8 +126,28 @@ fn main() {
         .skip(1)
         .find_map(|a| a.parse().ok())
         .unwrap_or(300);
+    measure(
+        "the real arm (both boards hear their echo)",
+        RobotConfig::default(),
+        requests,
+    );
+    println!();
+    measure(
+        "no echo on either board",
+        RobotConfig {
+            atom_hears_echo: false,
+            basic_hears_echo: false,
+            ..RobotConfig::default()
+        },
+        requests,
+    );
+}
+
+/// Runs the get_angles-during-motion session on a robot built from `config` and prints the
+/// figures.
+fn measure(label: &str, config: RobotConfig, requests: usize) {
     let wall = std::time::Instant::now();
-    let mut robot = VirtualRobot::new(RobotConfig::default());
+    let mut robot = VirtualRobot::new(config);
     robot.run_for(1_500_000);
     let basic = robot.basic_station().unwrap_or(robot.atom_station());
     let atom = robot.atom_station();
@@ -232,7 +252,8 @@ fn main() {
     }
 
     println!(
-        "virtual robot latency harness: {requests} get_angles during motion, {measured_s:.2} s virtual"
+        "virtual robot latency harness, {label}: {requests} get_angles during motion, \
+         {measured_s:.2} s virtual"
     );
     let (median, p99) = summary(
         "Atom reply (request end on bus -> reply start)",
