@@ -29,7 +29,7 @@ use super::tcp::{ClientId, TcpServer};
 pub const ACTIVE_TICK: Duration = Duration::from_micros(50);
 
 /// The longest the loop sleeps when the line is quiet (input still wakes it at once).
-pub const IDLE_TICK: Duration = Duration::from_millis(1);
+pub const IDLE_TICK: Duration = Duration::from_millis(5);
 
 /// How long after the last byte in either direction the loop keeps the short tick: longer
 /// than any reply takes to start (the firmware answers within a few milliseconds).
