@@ -643,7 +643,7 @@ impl Atom {
             Some(limit) => {
                 let angle = self.config.steps_to_angle(index, h.position);
                 let inside = Centideg(angle.0.clamp(limit.min.0, limit.max.0));
-                self.config.angle_to_steps(index, inside)
+                self.goal_steps(index, inside)
             }
             None => h.position,
         };
@@ -662,6 +662,21 @@ impl Atom {
     }
 
     // ----- motion -------------------------------------------------------------------------
+
+    /// The encoder goal for joint `j` at `angle`: the nearest step whose angle is still within
+    /// the joint's limits (a limit rarely falls on a whole step: 140 deg is step 3641.2, and
+    /// step 3641 reads 140.01 deg, which the choke point would refuse).
+    pub(crate) fn goal_steps(&self, j: usize, angle: Centideg) -> Steps {
+        let steps = self.config.angle_to_steps(j, angle);
+        let Some(limit) = self.limits.get(j) else {
+            return steps;
+        };
+        [steps.0, steps.0 - 1, steps.0 + 1]
+            .into_iter()
+            .map(Steps)
+            .find(|&s| limit.contains(self.config.steps_to_angle(j, s)))
+            .unwrap_or(steps)
+    }
 
     /// Present encoder positions of the joints.
     pub(crate) fn present_steps(&self) -> [Steps; JOINTS] {
@@ -713,7 +728,7 @@ impl Atom {
                 .get(j)
                 .copied()
                 .flatten()
-                .map(|a| self.config.angle_to_steps(j, a))
+                .map(|a| self.goal_steps(j, a))
         });
         let (goals, duration_us) = motion::plan_joint_move(
             &self.config,

@@ -474,3 +474,244 @@ fn power_on_before_the_first_state_read_does_not_move_the_arm() {
             .all(|&g| (g - 2500).abs() <= 2)
     );
 }
+
+#[test]
+fn every_atom_command_answers_in_the_layout_its_client_expects() {
+    use protocol_core::command::*;
+    use protocol_core::units::{Centideg, DeciMm, Decideg, SpeedPercent, Steps};
+    let j = |n| JointId::new(n).unwrap();
+    let s = |n| ServoId::new(n).unwrap();
+    let sp = SpeedPercent::new(50).unwrap();
+    let pin = |g| AtomPin::new(g).unwrap();
+    let zero = [Centideg(0); 6];
+    let pose = Pose {
+        x: DeciMm(1500),
+        y: DeciMm(-634),
+        z: DeciMm(2500),
+        rx: Centideg(-9000),
+        ry: Centideg(0),
+        rz: Centideg(-9000),
+    };
+    let gs = GripperSpeed::new(50).unwrap();
+    let requests = vec![
+        Request::GetModifyVersion,
+        Request::GetSystemVersion,
+        Request::ClearQueue,
+        Request::CheckAsyncOrSync,
+        Request::GetErrorInfo,
+        Request::ClearErrorInfo,
+        Request::IsPowerOn,
+        Request::PowerOn,
+        Request::IsControllerConnected,
+        Request::ReadNextError,
+        Request::SetFreshMode { fresh: true },
+        Request::GetFreshMode,
+        Request::SetFreeMode { on: false },
+        Request::IsFreeMode,
+        Request::SetVisionMode { on: false },
+        Request::GetRebootCount,
+        Request::GetAngles,
+        Request::SendAngle {
+            joint: j(1),
+            angle: Centideg(500),
+            speed: sp,
+        },
+        Request::SendAngles {
+            angles: zero,
+            speed: sp,
+        },
+        Request::GetCoords,
+        Request::AnglesToCoords { angles: zero },
+        Request::Pause,
+        Request::IsPaused,
+        Request::Resume,
+        Request::Stop,
+        Request::IsInPosition {
+            target: PositionTarget::Angles(zero),
+        },
+        Request::IsMoving,
+        Request::SolveIk {
+            target: pose,
+            current: zero,
+        },
+        Request::GetAnglesCoords,
+        Request::GetPlannedAngles,
+        Request::GetPlannedCoords,
+        Request::JogAngle {
+            joint: j(2),
+            direction: Direction::Positive,
+            speed: sp,
+        },
+        Request::JogStop,
+        Request::JogIncrementAngle {
+            joint: j(2),
+            increment: Centideg(100),
+            speed: sp,
+        },
+        Request::SetEncoder {
+            servo: s(1),
+            encoder: Steps(2100),
+            speed: Some(sp),
+        },
+        Request::GetEncoder { servo: s(1) },
+        Request::SetEncoders {
+            encoders: [Steps(2048); 6],
+            speed: sp,
+        },
+        Request::GetEncoders,
+        Request::SetEncodersDrag {
+            encoders: [Steps(2048); 6],
+            speeds_steps_per_s: [500; 6],
+        },
+        Request::GetSpeed,
+        Request::SetSpeed { speed: sp },
+        Request::GetJointMin { joint: j(3) },
+        Request::GetJointMax { joint: j(3) },
+        Request::SetJointMin {
+            joint: j(3),
+            limit: Decideg(-1500),
+        },
+        Request::SetJointMax {
+            joint: j(3),
+            limit: Decideg(1500),
+        },
+        Request::IsServoEnabled { servo: s(2) },
+        Request::AreAllServosEnabled,
+        Request::SetServoData {
+            servo: s(2),
+            address: 21,
+            value: ServoValue::Byte(10),
+        },
+        Request::GetServoData {
+            servo: s(2),
+            address: 21,
+            width: None,
+        },
+        Request::GetServoData {
+            servo: s(2),
+            address: 56,
+            width: Some(DataWidth::Word),
+        },
+        Request::JointBrake { servo: s(2) },
+        Request::ReleaseServo {
+            servo: s(2),
+            undamped: None,
+        },
+        Request::FocusServo {
+            servo: ServoSelect::One(s(2)),
+        },
+        Request::GetServoSpeeds,
+        Request::GetServoCurrents,
+        Request::GetServoVoltages,
+        Request::GetServoStatus,
+        Request::GetServoTemps,
+        Request::BackupServoParams {
+            servo: ServoSelect::All,
+        },
+        Request::RestoreServoParams {
+            servo: ServoSelect::All,
+        },
+        Request::SetPinMode {
+            pin: pin(19),
+            mode: PinMode::Output,
+        },
+        Request::SetDigitalOutput {
+            pin: pin(19),
+            high: true,
+        },
+        Request::GetDigitalInput { pin: pin(19) },
+        Request::SetPwmOutput {
+            pin: pin(33),
+            frequency_hz: 500,
+            duty: 100,
+        },
+        Request::GetGripperValue { gripper: None },
+        Request::SetGripperStateNoSpeed {
+            state: GripperState::Open,
+        },
+        Request::SetGripperState {
+            state: GripperState::Close,
+            speed: gs,
+            model: GripperModel::Default,
+        },
+        Request::SetGripperValue {
+            value: GripperValue::new(40).unwrap(),
+            speed: gs,
+            model: GripperModel::Default,
+        },
+        Request::IsGripperMoving,
+        Request::SetColor {
+            rgb: Rgb { r: 1, g: 2, b: 3 },
+        },
+        Request::SetHtsGripperTorque { torque: 300 },
+        Request::GetHtsGripperTorque,
+        Request::GetGripperProtectCurrent,
+        Request::SetGripperProtectCurrent { current: 100 },
+        Request::SetToolReference { pose },
+        Request::GetToolReference,
+        Request::SetWorldReference { pose },
+        Request::GetWorldReference,
+        Request::SetReferenceFrame {
+            frame: ReferenceFrame::Base,
+        },
+        Request::GetReferenceFrame,
+        Request::SetMovementType {
+            mode: MoveMode::Joint,
+        },
+        Request::GetMovementType,
+        Request::SetEndType {
+            end: EndType::Flange,
+        },
+        Request::GetEndType,
+        Request::SendCoords {
+            pose,
+            speed: sp,
+            mode: Some(MoveMode::Joint),
+        },
+        Request::SendCoord {
+            target: AxisValue::new(Axis::Z, 2400),
+            speed: sp,
+        },
+        Request::JogIncrementCoord {
+            increment: AxisValue::new(Axis::X, 50),
+            speed: sp,
+        },
+        Request::JogCoord {
+            axis: Axis::Y,
+            direction: Direction::Negative,
+            speed: sp,
+        },
+        Request::JogRpy {
+            axis: RpyAxis::Yaw,
+            direction: Direction::Positive,
+            speed: sp,
+        },
+        Request::SetServoCalibration { servo: s(7) },
+        Request::SetGripperCalibration,
+        Request::ReleaseAllServos { undamped: None },
+        Request::PowerOff,
+    ];
+    let mut rig = Rig::new();
+    for request in requests {
+        let reply = rig
+            .request(&request.to_frame())
+            .unwrap_or_else(|| panic!("no reply to {request:?}"));
+        assert_eq!(reply.cmd(), request.cmd(), "{request:?}");
+        let parsed = Reply::parse(request.reply_kind(), &reply);
+        assert!(parsed.is_ok(), "{request:?} -> {reply:?}: {parsed:?}");
+        rig.run_ms(30);
+    }
+}
+
+#[test]
+fn a_move_to_exactly_the_limit_is_accepted() {
+    let mut rig = Rig::new();
+    // 140 deg is not a whole encoder step; the nearest step inside the limit is used.
+    let mut data = vec![2];
+    data.extend(be(&[14_000]));
+    data.push(100);
+    assert_eq!(rig.ask(0x21, &data), [1]);
+    rig.run_ms(3000);
+    let a = angles(&mut rig)[1];
+    assert!((13_990..=14_000).contains(&a), "{a}");
+}

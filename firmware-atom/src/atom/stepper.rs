@@ -230,10 +230,8 @@ impl Atom {
         })?;
         let present = self.present_steps();
         let max_speed = u64::from(motion::joint_speed_steps(&self.config, speed_percent));
-        let goal_steps: [Steps; JOINTS] = core::array::from_fn(|j| {
-            self.config
-                .angle_to_steps(j, q.get(j).copied().unwrap_or_default())
-        });
+        let goal_steps: [Steps; JOINTS] =
+            core::array::from_fn(|j| self.goal_steps(j, q.get(j).copied().unwrap_or_default()));
         let travel = |j: usize| -> u64 {
             match (goal_steps.get(j), present.get(j)) {
                 (Some(g), Some(p)) => u64::from((i32::from(g.0) - i32::from(p.0)).unsigned_abs()),
