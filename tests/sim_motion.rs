@@ -262,3 +262,31 @@ fn powering_on_after_hand_posing_holds_the_new_pose() {
         assert_eq!(robot.measured_angles(), posed, "{hold:?} moved the arm");
     }
 }
+
+#[test]
+fn a_jog_whose_client_vanished_stops_by_itself() {
+    use protocol_core::command::Direction;
+    let mut robot = arm();
+    ack(
+        &mut robot,
+        Request::JogAngle {
+            joint: JointId::new(1).expect("joint 1"),
+            direction: Direction::Positive,
+            speed: speed(20),
+        },
+    );
+    robot.run_for(500_000);
+    let moving_at = robot.measured_angles()[0];
+    assert!(moving_at.0 > 0, "the jog started");
+    // The client crashed: no stop ever comes. The jog watchdog (2 s, about 60 degrees at this
+    // speed) must end it long before the joint limit (168 degrees).
+    robot.run_for(5_000_000);
+    let stopped_at = robot.measured_angles()[0];
+    assert!(
+        stopped_at.0 < 12_000,
+        "the jog ran on without its client: joint 1 at {stopped_at:?}"
+    );
+    robot.run_for(1_000_000);
+    assert_eq!(robot.measured_angles()[0], stopped_at, "still jogging");
+    assert_eq!(ask(&mut robot, Request::IsMoving), Reply::Byte(0));
+}
