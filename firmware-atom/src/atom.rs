@@ -380,7 +380,11 @@ impl Atom {
         link: Link,
         io: &mut I,
     ) -> Option<Frame> {
-        self.last_host_cmd_us = now_us;
+        // The Basic's own liveness probe (is powered on, every second while the wire is idle)
+        // says nothing about the client, so it does not keep a jog alive.
+        if frame.cmd() != protocol_core::command::cmd::IS_POWER_ON {
+            self.last_host_cmd_us = now_us;
+        }
         crate::commands::handle(self, now_us, frame, link, io)
     }
 
@@ -619,6 +623,10 @@ impl Atom {
                 None => true,
             }
         } else {
+            // A limp servo holds no goal: nothing to compare its read-back against.
+            if let Some(last) = self.last_goal.get_mut(index) {
+                *last = None;
+            }
             Op::write(id, reg::TORQUE_ENABLE, &[0])
                 .is_some_and(|op| self.queue_op(op, Then::Nothing))
         };
@@ -633,8 +641,9 @@ impl Atom {
 
     /// The write that switches servo `index` on holding its present position (pulled into
     /// the joint limits if the arm was moved beyond them by hand, at [`HOLD_SPEED_PERCENT`]);
-    /// `None` until the servo's position has been read.
-    fn torque_on_op(&self, index: usize, id: u8) -> Option<Op> {
+    /// `None` until the servo's position has been read. The hold goal becomes the servo's
+    /// last goal (what the read-back compares against).
+    fn torque_on_op(&mut self, index: usize, id: u8) -> Option<Op> {
         let h = self.health.get(index)?;
         if !h.answering {
             return None;
@@ -656,9 +665,12 @@ impl Atom {
                 accel: motion::joint_accel_register(&self.config),
             });
         }
-        safety::check(&self.config, &self.limits, self.powered, one)
-            .ok()?
-            .torque_on_write(index, id)
+        let safe = safety::check(&self.config, &self.limits, self.powered, one).ok()?;
+        let op = safe.torque_on_write(index, id)?;
+        if let Some(last) = self.last_goal.get_mut(index) {
+            *last = safe.goals().get(index).copied().flatten();
+        }
+        Some(op)
     }
 
     // ----- motion -------------------------------------------------------------------------

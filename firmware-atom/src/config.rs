@@ -122,7 +122,8 @@ pub struct TimingBudget {
     /// Period of the straight-line and jog interpolators: a new set of goals every 20 ms, short
     /// enough that the servos' own ramp keeps the path within a fraction of a millimetre.
     pub interpolation_period_us: u64,
-    /// A continuous jog (0x30..0x32) stops if no host command arrives for this long. 2 s: long
+    /// A continuous jog (0x30..0x32) stops if no host command (other than the Basic's probe,
+    /// 0x12) arrives for this long. 2 s: long
     /// enough for a script that jogs, sleeps a second and stops (pymycobot has no keep-alive),
     /// short enough that a lost link cannot drive a joint far (at most 2 s of motion).
     pub jog_watchdog_us: u64,

@@ -31,7 +31,9 @@
 //! * **Jog watchdog.** A continuous jog (0x30..0x32) stops when no host command has arrived
 //!   for 2 s ([`TimingBudget::jog_watchdog_us`]): pymycobot has no keep-alive, so a script
 //!   that jogs, sleeps a second and stops still works, while a lost link moves a joint for at
-//!   most 2 s. Jog stop (0x34 LEN 2), stop (0x29) or any new motion end it earlier.
+//!   most 2 s. Any command counts as a sign of life except is powered on (0x12), which the
+//!   Basic sends by itself as its liveness probe. Jog stop (0x34 LEN 2), stop (0x29) or any
+//!   new motion end it earlier.
 //! * **Gripper** (servo 7): value 0 (closed) ..= 100 (open) maps linearly onto the encoder
 //!   range [`config::GripperRange`] (default 2048 ..= 3072); calibration (0x68) makes the
 //!   present position the new closed end (the servo's present position becomes 2048).

@@ -138,3 +138,21 @@ fn free_mode_button_releases_the_joints_while_held() {
     rig.run_ms(20);
     assert!(rig.bus.servo(2).torque_on());
 }
+
+#[test]
+fn free_mode_holds_the_pose_the_hand_left() {
+    let mut rig = Rig::new();
+    assert_eq!(rig.ask(0x1A, &[1]), [1]);
+    rig.io.button = true;
+    rig.run_ms(20);
+    // The user swings joint 1 to about 30 degrees while the button is held.
+    rig.bus.servo(1).position = 2048.0 + 341.0;
+    rig.run_ms(50);
+    rig.io.button = false;
+    rig.run_ms(500);
+    assert!(rig.bus.servo(1).torque_on());
+    let posed = rig.ask_i16(0x20, &[])[0];
+    assert!((posed - 3000).abs() <= 10, "{posed}");
+    rig.run_ms(1000);
+    assert_eq!(rig.ask_i16(0x20, &[])[0], posed, "holds the pose");
+}

@@ -715,3 +715,16 @@ fn a_move_to_exactly_the_limit_is_accepted() {
     let a = angles(&mut rig)[1];
     assert!((13_990..=14_000).contains(&a), "{a}");
 }
+
+#[test]
+fn the_basics_liveness_probe_does_not_keep_a_jog_alive() {
+    let mut rig = Rig::new();
+    assert_eq!(rig.ask(0x30, &[1, 1, 10]), [1]);
+    for _ in 0..6 {
+        rig.run_ms(1000);
+        assert_eq!(rig.ask(0x12, &[]), [1], "the Basic's probe");
+    }
+    let a = angles(&mut rig)[0];
+    rig.run_ms(1000);
+    assert_eq!(angles(&mut rig)[0], a, "stopped despite the probes");
+}
