@@ -283,6 +283,11 @@ fn measure(label: &str, config: RobotConfig, requests: usize) {
         "  target >= {REFRESH_TARGET_HZ} Hz on every joint: {}",
         verdict(slowest >= REFRESH_TARGET_HZ)
     );
+    let busy_ns: u64 = trace.iter().map(|b| b.end_ns - b.start_ns).sum();
+    println!(
+        "bus busy {:.0} % of the time",
+        busy_ns as f64 / (measured_s * 1e9) * 100.0
+    );
     let forwarded = basic_frames.len();
     let hit = basic_frames.iter().filter(|f| f.garbled).count();
     let replies_hit = atom_frames.iter().filter(|f| f.garbled).count();
