@@ -141,6 +141,16 @@ fn main() {
         },
         requests,
     );
+    println!();
+    measure(
+        "slow main loops (Atom 200 us, Basic 50 us per pass)",
+        RobotConfig {
+            atom_loop_us: 200,
+            basic_loop_us: 50,
+            ..RobotConfig::default()
+        },
+        requests,
+    );
 }
 
 /// Runs the get_angles-during-motion session on a robot built from `config` and prints the

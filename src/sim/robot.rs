@@ -36,6 +36,12 @@ pub struct RobotConfig {
     pub basic: BasicConfig,
     /// Encoder position of every servo at power-up, in steps (2048 = 0 degrees).
     pub initial_position_steps: u16,
+    /// Time one pass of the Atom's main loop takes, in us: the Atom is polled only this often
+    /// (bytes wait in its UART meanwhile). 0 (the default) polls it whenever anything happens
+    /// and at least every [`POLL_PERIOD_NS`], i.e. an infinitely fast board.
+    pub atom_loop_us: u64,
+    /// Like [`RobotConfig::atom_loop_us`] for the Basic.
+    pub basic_loop_us: u64,
 }
 
 impl Default for RobotConfig {
@@ -51,6 +57,8 @@ impl Default for RobotConfig {
             },
             basic: BasicConfig::default(),
             initial_position_steps: 2048,
+            atom_loop_us: 0,
+            basic_loop_us: 0,
         }
     }
 }
@@ -96,6 +104,36 @@ impl BasicIo for SimBasicIo {
     }
 }
 
+/// When a board's main loop runs next (see [`RobotConfig::atom_loop_us`]).
+#[derive(Clone, Copy, Debug)]
+struct BoardLoop {
+    period_ns: u64,
+    next_ns: u64,
+}
+
+impl BoardLoop {
+    fn new(period_us: u64) -> Self {
+        Self {
+            period_ns: period_us.saturating_mul(1_000),
+            next_ns: 0,
+        }
+    }
+
+    /// Whether the board runs at `now_ns`; if so, schedules its next pass.
+    fn runs_at(&mut self, now_ns: u64) -> bool {
+        let due = now_ns >= self.next_ns;
+        if due {
+            self.next_ns = now_ns + self.period_ns;
+        }
+        due
+    }
+
+    /// When the next pass is due, for a board that does not run on every event.
+    fn next_event_ns(&self) -> Option<u64> {
+        (self.period_ns > 0).then_some(self.next_ns)
+    }
+}
+
 /// A board's USB serial: what the host sent to it and what it sends to the host.
 #[derive(Clone, Debug)]
 struct UsbLink {
@@ -135,6 +173,7 @@ impl UsbLink {
 struct BasicBoard {
     firmware: Basic,
     config: BasicConfig,
+    main_loop: BoardLoop,
     /// When the firmware last started, in ns: its clock starts at 0 there.
     boot_ns: u64,
     station: StationId,
@@ -182,6 +221,7 @@ pub struct VirtualRobot {
     atom_config: AtomConfig,
     /// When the Atom firmware last started, in ns: its clock starts at 0 there.
     atom_boot_ns: u64,
+    atom_loop: BoardLoop,
     atom_station: StationId,
     atom_usb: UsbLink,
     atom_io: RecordingIo,
@@ -201,6 +241,7 @@ impl VirtualRobot {
         let basic = config.with_basic.then(|| BasicBoard {
             firmware: Basic::new(config.basic),
             config: config.basic,
+            main_loop: BoardLoop::new(config.basic_loop_us),
             boot_ns: 0,
             station: bus.attach(config.basic_hears_echo),
             usb: UsbLink::new(),
@@ -223,6 +264,7 @@ impl VirtualRobot {
             atom: Atom::new(config.atom),
             atom_config: config.atom,
             atom_boot_ns: 0,
+            atom_loop: BoardLoop::new(config.atom_loop_us),
             atom_station,
             atom_usb: UsbLink::new(),
             atom_io: RecordingIo::default(),
@@ -338,6 +380,12 @@ impl VirtualRobot {
         consider(self.bus.next_event_ns());
         consider(self.atom_usb.next_event_ns());
         consider(self.basic.as_ref().and_then(|b| b.usb.next_event_ns()));
+        consider(self.atom_loop.next_event_ns());
+        consider(
+            self.basic
+                .as_ref()
+                .and_then(|b| b.main_loop.next_event_ns()),
+        );
         for s in &self.servos {
             consider(s.servo.next_event_ns());
         }
@@ -375,6 +423,7 @@ impl VirtualRobot {
             }
         }
         if let Some(basic) = self.basic.as_mut()
+            && basic.main_loop.runs_at(now_ns)
             && let Some(mut bus) = self.bus.port(basic.station)
         {
             let mut host = basic.usb.board_port(now_ns);
@@ -383,7 +432,9 @@ impl VirtualRobot {
                 .firmware
                 .poll(basic_us, &mut host, &mut bus, &mut basic.io);
         }
-        if let Some(mut bus) = self.bus.port(self.atom_station) {
+        if self.atom_loop.runs_at(now_ns)
+            && let Some(mut bus) = self.bus.port(self.atom_station)
+        {
             let mut usb = self.atom_usb.board_port(now_ns);
             let atom_us = (now_ns - self.atom_boot_ns) / 1_000;
             self.atom
@@ -620,6 +671,25 @@ mod tests {
         let first = session();
         assert!(!first.is_empty());
         assert_eq!(first, session());
+    }
+
+    #[test]
+    fn a_slow_main_loop_answers_later() {
+        let round_trip = |atom_loop_us| {
+            let mut robot = VirtualRobot::new(RobotConfig {
+                with_basic: false,
+                atom_loop_us,
+                ..RobotConfig::default()
+            });
+            robot.run_for(100_000);
+            let start = robot.now_us();
+            let reply = robot.transact_on(HostLink::AtomUsb, &Request::IsPowerOn.to_frame());
+            assert!(reply.is_some(), "loop {atom_loop_us} us: no answer");
+            robot.now_us() - start
+        };
+        let fast = round_trip(0);
+        let slow = round_trip(5_000);
+        assert!(slow > fast + 1_000, "fast {fast} us, slow {slow} us");
     }
 
     #[test]
