@@ -178,8 +178,10 @@ fn execute<I: AtomIo>(
             Answer::Done(Ok(()))
         }
         R::IsInPosition { target } => {
+            // Near the target and at rest: pymycobot's sync_send_angles returns as soon as this
+            // says 1, so a pose passed through on the way does not count.
             let present = atom.present_angles();
-            let inside = match target {
+            let near = match target {
                 protocol_core::command::PositionTarget::Angles(a) => {
                     motion::angles_match(&present, &a)
                 }
@@ -188,7 +190,7 @@ fn execute<I: AtomIo>(
                     coords_match(&now, &p)
                 }
             };
-            byte(inside)
+            byte(near && !atom.is_moving())
         }
         R::IsMoving => byte(atom.is_moving()),
         R::SolveIk { target, current } => match atom.cart.inverse(&target, &current) {

@@ -728,3 +728,27 @@ fn the_basics_liveness_probe_does_not_keep_a_jog_alive() {
     rig.run_ms(1000);
     assert_eq!(angles(&mut rig)[0], a, "stopped despite the probes");
 }
+
+#[test]
+fn is_in_position_waits_for_the_arm_to_come_to_rest() {
+    let mut rig = Rig::new();
+    let target = [2000i16, 0, 0, 0, 0, 0];
+    let mut data = be(&target);
+    data.push(20);
+    rig.ask(SEND_ANGLES, &data);
+    let mut query = be(&target);
+    query.push(0);
+    // Poll like sync_send_angles; the first 1 must come with the arm at the target.
+    for _ in 0..100 {
+        if rig.ask(0x2A, &query) == [1] {
+            assert!(
+                close(&angles(&mut rig), &target, 9),
+                "{:?}",
+                angles(&mut rig)
+            );
+            return;
+        }
+        rig.run_ms(50);
+    }
+    panic!("never in position");
+}
