@@ -909,7 +909,11 @@ impl Atom {
                 now_us.saturating_sub(self.last_host_cmd_us) >= self.config.timing.jog_watchdog_us;
             if jog && host_silent {
                 self.halt(true);
-            } else if arrived || elapsed > duration_us + motion::MOVE_OVERTIME_US {
+            } else if self.stepper.is_none()
+                && (arrived || elapsed > duration_us + motion::MOVE_OVERTIME_US)
+            {
+                // (A stepped motion is over only when its stepper is: a slow jog catches up
+                // with each step before the next one.)
                 self.activity = Activity::Idle;
             }
         }

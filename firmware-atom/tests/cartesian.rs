@@ -156,3 +156,20 @@ fn free_mode_holds_the_pose_the_hand_left() {
     rig.run_ms(1000);
     assert_eq!(rig.ask_i16(0x20, &[])[0], posed, "holds the pose");
 }
+
+#[test]
+fn a_slow_coordinate_jog_is_moving_until_stopped_and_the_watchdog_ends_it() {
+    let mut rig = Rig::new();
+    move_to_angles(&mut rig, [0, -3000, -6000, 0, 0, 0]);
+    assert_eq!(rig.ask(0x32, &[1, 1, 1]), [1], "jog x at 1 %");
+    for _ in 0..5 {
+        rig.run_ms(200);
+        assert_eq!(rig.ask(0x2B, &[]), [1], "still jogging");
+    }
+    // The host goes silent: the watchdog stops the jog.
+    rig.run_ms(3000);
+    let a = rig.atom.present_angles();
+    rig.run_ms(1000);
+    assert_eq!(rig.atom.present_angles(), a, "stopped");
+    assert_eq!(rig.ask(0x2B, &[]), [0]);
+}
