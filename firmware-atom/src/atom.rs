@@ -22,7 +22,7 @@ use protocol_core::{BytePort, Frame, FrameDecoder};
 
 use crate::bus::{BusEvent, BusReceiver};
 use crate::cartesian::Cartesian;
-use crate::config::{AtomConfig, ConfigError, GRIPPER, JOINTS, JointLimit, SERVOS};
+use crate::config::{AtomConfig, ConfigError, GRIPPER, JOINTS, JointLimit, SERVOS, STEPS_PER_TURN};
 use crate::driver::{Op, Outcome, ServoDriver};
 use crate::health::ServoHealth;
 use crate::io::AtomIo;
@@ -810,7 +810,7 @@ impl Atom {
                 .is_some_and(|h| h.torque_on && h.answering);
             if let (true, Some(&p)) = (torque, present.get(j)) {
                 *slot = Some(Goal {
-                    position: p,
+                    position: self.braking_point(j, p, accel),
                     speed_steps_per_s: speed,
                     accel,
                 });
@@ -825,6 +825,22 @@ impl Atom {
                 let _ = self.send_goals(one);
             }
         }
+    }
+
+    /// Where joint `j`, at `present` and moving at its last read speed, comes to rest when it
+    /// brakes with acceleration register `accel` (100 steps/s^2 units): `v^2 / 2a` further on,
+    /// kept within the joint's limits. Holding at the present position instead would make a
+    /// fast joint overshoot and swing back (a jog at full speed runs on about 14 degrees).
+    fn braking_point(&self, j: usize, present: Steps, accel: u8) -> Steps {
+        let speed = i64::from(self.health.get(j).map_or(0, |h| h.speed_steps_per_s));
+        let decel = i64::from(accel.max(1)) * 100;
+        let travel = speed * speed.abs() / (2 * decel);
+        let beyond = (i64::from(present.0) + travel).clamp(0, i64::from(STEPS_PER_TURN) - 1);
+        let mut angle = self.config.steps_to_angle(j, Steps(beyond as i16));
+        if let Some(limit) = self.limits.get(j) {
+            angle = angle.clamp(limit.min, limit.max);
+        }
+        self.goal_steps(j, angle)
     }
 
     /// Pauses the current motion (it can be resumed).

@@ -1,0 +1,90 @@
+//! Stopping a moving arm: it brakes and stays where it stopped, it never swings back.
+
+mod sim_support;
+
+use open_mycobot::sim::VirtualRobot;
+use protocol_core::command::{Direction, JointId, Request};
+use protocol_core::units::Centideg;
+use sim_support::*;
+
+/// Angle of joint 1 measured at the shaft every millisecond for `duration_us`.
+fn joint1_trace(robot: &mut VirtualRobot, duration_us: u64) -> Vec<i16> {
+    (0..duration_us / 1000)
+        .map(|_| {
+            robot.run_for(1000);
+            robot.measured_angles()[0].0
+        })
+        .collect()
+}
+
+/// Drives joint 1 positively at `speed_percent`, then sends `stop` and checks that from then
+/// on the joint only slows down in the same direction and comes to rest.
+fn brakes_without_reversing(stop: Request, speed_percent: u8) {
+    let mut robot = arm();
+    ack(
+        &mut robot,
+        Request::JogAngle {
+            joint: JointId::new(1).expect("joint 1"),
+            direction: Direction::Positive,
+            speed: speed(speed_percent),
+        },
+    );
+    robot.run_for(800_000);
+    let at_stop = robot.measured_angles()[0];
+    assert!(
+        at_stop > Centideg(2_000),
+        "the jog moved joint 1: {at_stop:?}"
+    );
+    ack(&mut robot, stop);
+    let trace = joint1_trace(&mut robot, 1_500_000);
+    let furthest = trace.iter().copied().max().unwrap_or(at_stop.0);
+    let rest = *trace.last().expect("trace");
+    assert!(
+        furthest - rest <= ANGLE_TOLERANCE,
+        "joint 1 swung back after the stop: from {} to furthest {furthest}, then back to {rest} (centideg)",
+        at_stop.0
+    );
+    wait_until_stopped(&mut robot);
+    assert_eq!(
+        get_angles(&mut robot)[0].0 / 10,
+        robot.measured_angles()[0].0 / 10
+    );
+}
+
+#[test]
+fn stop_brakes_a_fast_jog_without_swinging_back() {
+    brakes_without_reversing(Request::Stop, 100);
+}
+
+#[test]
+fn jog_stop_brakes_without_swinging_back() {
+    brakes_without_reversing(Request::JogStop, 60);
+}
+
+#[test]
+fn pause_brakes_a_move_without_swinging_back() {
+    let mut robot = arm();
+    ack(
+        &mut robot,
+        Request::SendAngles {
+            angles: degrees([120.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            speed: speed(100),
+        },
+    );
+    robot.run_for(500_000);
+    ack(&mut robot, Request::Pause);
+    let trace = joint1_trace(&mut robot, 1_500_000);
+    let furthest = trace.iter().copied().max().unwrap_or_default();
+    let rest = *trace.last().expect("trace");
+    assert!(
+        furthest - rest <= ANGLE_TOLERANCE,
+        "swung back from {furthest} to {rest}"
+    );
+    ack(&mut robot, Request::Resume);
+    wait_until_stopped(&mut robot);
+    assert_angles_near(
+        robot.measured_angles(),
+        degrees([120.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        "resumed move arrives",
+    );
+}
