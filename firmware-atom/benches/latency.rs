@@ -1,4 +1,4 @@
-//! Latency and refresh-rate harness: the Atom with fake servos under virtual time, while a
+//! Latency and refresh-rate harness: the Atom with simulated servos under virtual time, while a
 //! motion runs and the state refresh is active, answering get_angles sent by a Basic-like
 //! host at pseudo-random moments. Prints the median / p99 / max time from the request's last
 //! byte to the reply's first byte (leaving the Atom) and last byte, and the refresh rate.

@@ -133,10 +133,10 @@ fn free_mode_button_releases_the_joints_while_held() {
     assert_eq!(rig.ask(0x1B, &[]), [1]);
     rig.io.button = true;
     rig.run_ms(20);
-    assert!(!rig.bus.servo(2).torque_on());
+    assert!(!rig.bus.servo(2).torque_enabled());
     rig.io.button = false;
     rig.run_ms(20);
-    assert!(rig.bus.servo(2).torque_on());
+    assert!(rig.bus.servo(2).torque_enabled());
 }
 
 #[test]
@@ -146,11 +146,11 @@ fn free_mode_holds_the_pose_the_hand_left() {
     rig.io.button = true;
     rig.run_ms(20);
     // The user swings joint 1 to about 30 degrees while the button is held.
-    rig.bus.servo(1).position = 2048.0 + 341.0;
+    rig.bus.servo(1).move_by_hand(2048 + 341);
     rig.run_ms(50);
     rig.io.button = false;
     rig.run_ms(500);
-    assert!(rig.bus.servo(1).torque_on());
+    assert!(rig.bus.servo(1).torque_enabled());
     let posed = rig.ask_i16(0x20, &[])[0];
     assert!((posed - 3000).abs() <= 10, "{posed}");
     rig.run_ms(1000);

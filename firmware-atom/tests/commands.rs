@@ -1,9 +1,12 @@
-//! The Atom answering host commands like a user's script would drive it, against fake servos.
+//! The Atom answering host commands like a user's script would drive it, against simulated
+//! servos on a simulated wire.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
 
 mod support;
 
 use protocol_core::Frame;
+use sim_hw::Faults;
+use sim_hw::servo::{AMBIENT_C, OVERHEAT_C};
 use support::rig::{Rig, be};
 
 const GET_ANGLES: u8 = 0x20;
@@ -53,13 +56,13 @@ fn send_angles_moves_all_joints_to_arrive_together() {
 #[test]
 fn out_of_limit_angle_is_refused_and_changes_nothing() {
     let mut rig = Rig::new();
-    let goals_before = rig.bus.servo(2).goals.len();
+    let goals_before = rig.bus.goals[1].len();
     let mut data = be(&[0, 15_000, 0, 0, 0, 0]); // J2 limit is 140 deg
     data.push(50);
     assert_eq!(rig.ask(SEND_ANGLES, &data), [0]);
     assert_eq!(rig.ask(0x07, &[]), [2], "error code names joint 2");
     rig.run_ms(100);
-    assert_eq!(rig.bus.servo(2).goals.len(), goals_before);
+    assert_eq!(rig.bus.goals[1].len(), goals_before);
     assert_eq!(angles(&mut rig), [0; 6]);
     assert_eq!(rig.ask(0x08, &[]), [1]);
     assert_eq!(rig.ask(0x07, &[]), [0]);
@@ -86,14 +89,14 @@ fn power_off_refuses_motion_and_power_on_restores_it() {
     assert_eq!(rig.ask(0x11, &[]), [1]);
     assert_eq!(rig.ask(0x12, &[]), [0]);
     rig.run_ms(20);
-    assert!(!rig.bus.servo(1).torque_on());
+    assert!(!rig.bus.servo(1).torque_enabled());
     let mut send = vec![1];
     send.extend(be(&[2000]));
     send.push(50);
     assert_eq!(rig.ask(0x21, &send), [0]);
     assert_eq!(rig.ask(0x10, &[]), [1]);
     rig.run_ms(20);
-    assert!(rig.bus.servo(1).torque_on());
+    assert!(rig.bus.servo(1).torque_enabled());
     assert_eq!(rig.ask(0x21, &send), [1]);
     rig.run_ms(2000);
     assert!(close(&angles(&mut rig)[..1], &[2000], 10));
@@ -253,31 +256,31 @@ fn gripper_value_and_state() {
 fn servo_data_read_and_eeprom_write() {
     let mut rig = Rig::new();
     // Read present temperature (addr 63) of servo 3.
-    assert_eq!(rig.ask(0x53, &[3, 63]), [31]);
+    assert_eq!(rig.ask(0x53, &[3, 63]), [AMBIENT_C]);
     // Two-byte read of the present position.
     assert_eq!(rig.ask(0x53, &[3, 56, 1]), [0x08, 0x00]);
     // EEPROM write (P coefficient, addr 21): unlocked, written, locked again.
     assert_eq!(rig.ask(0x52, &[3, 21, 40]), [1]);
     rig.run_ms(10);
-    assert_eq!(rig.bus.servo(3).table[21], 40);
-    assert_eq!(rig.bus.servo(3).table[55], 1, "EEPROM locked again");
+    assert_eq!(rig.bus.servo(3).reg(21), 40);
+    assert_eq!(rig.bus.servo(3).reg(55), 1, "EEPROM locked again");
     // The id and baud rate are refused (the servo would leave the arm's bus).
     assert_eq!(rig.ask(0x52, &[3, 5, 9]), [0]);
     rig.run_ms(10);
-    assert_eq!(rig.bus.servo(3).table[5], 3);
+    assert_eq!(rig.bus.servo(3).reg(5), 3);
     // A raw write to the goal register goes through the limits.
     let mut goal = vec![1, 42];
     goal.extend(be(&[4095]));
     goal.push(1);
     let _ = rig.ask(0x52, &goal);
     rig.run_ms(10);
-    assert!(rig.bus.servo(1).goals.iter().all(|&g| g < 4000));
+    assert!(rig.bus.goals[0].iter().all(|&g| g < 4000));
 }
 
 #[test]
 fn missing_servo_is_reported_and_others_keep_working() {
     let mut rig = Rig::new();
-    rig.bus.servo(4).present = false;
+    rig.bus.servo(4).set_faults(Faults::NO_ANSWER);
     rig.run_ms(50);
     assert_eq!(rig.ask(0x50, &[4]), [4, 0]);
     assert_eq!(rig.ask(0x50, &[3]), [3, 1]);
@@ -301,19 +304,21 @@ fn missing_servo_is_reported_and_others_keep_working() {
 #[test]
 fn servo_fault_is_reported() {
     let mut rig = Rig::new();
-    rig.bus.servo(5).table[65] = 4; // overheat
+    rig.bus.servo(5).set_faults(Faults::OVERHEAT);
     rig.run_ms(20);
     let status = rig.ask(0xE4, &[]);
     assert_eq!(status, [0, 0, 0, 0, 4, 0]);
     assert_eq!(rig.ask(0x15, &[])[4], 36);
-    assert_eq!(rig.ask(0xE5, &[]), [31; 6]);
+    let mut temps = [AMBIENT_C; 6];
+    temps[4] = OVERHEAT_C;
+    assert_eq!(rig.ask(0xE5, &[]), temps);
     assert_eq!(rig.ask(0xE3, &[]), [120; 6]);
 }
 
 #[test]
 fn a_servo_with_corrupt_answers_is_reported_as_such() {
     let mut rig = Rig::new();
-    rig.bus.servo(6).corrupt_answers = u32::MAX;
+    rig.bus.servo(6).set_faults(Faults::BAD_CHECKSUM);
     rig.run_ms(50);
     assert_eq!(rig.ask(0x15, &[]), [0, 0, 0, 0, 0, 17, 0]);
     assert_eq!(angles(&mut rig), [0; 6], "the host is still served");
@@ -322,8 +327,8 @@ fn a_servo_with_corrupt_answers_is_reported_as_such() {
 #[test]
 fn corrupt_answers_are_retried() {
     let mut rig = Rig::new();
-    rig.bus.servo(2).corrupt_answers = 1;
-    assert_eq!(rig.ask(0x53, &[2, 63]), [31]);
+    rig.bus.servo(2).corrupt_next_answers(1);
+    assert_eq!(rig.ask(0x53, &[2, 63]), [AMBIENT_C]);
 }
 
 #[test]
@@ -374,7 +379,7 @@ fn works_on_a_bus_without_echo() {
         },
         false,
     );
-    assert_eq!(rig.ask(0x53, &[1, 63]), [31]);
+    assert_eq!(rig.ask(0x53, &[1, 63]), [AMBIENT_C]);
     let mut data = be(&[1000, 0, 0, 0, 0, 0]);
     data.push(100);
     assert_eq!(rig.ask(SEND_ANGLES, &data), [1]);
@@ -394,7 +399,7 @@ fn usb_link_gets_the_same_commands() {
     // get servo data over USB: the reply comes back on USB after the servo read.
     rig.usb.send_frame(&Frame::new(0x53, &[1, 63]).unwrap());
     rig.run_ms(10);
-    assert_eq!(rig.usb.replies[2].data(), [31]);
+    assert_eq!(rig.usb.replies[2].data(), [AMBIENT_C]);
 }
 
 #[test]
@@ -430,29 +435,28 @@ fn own_reply_heard_late_is_not_taken_for_a_request() {
 fn lost_goal_and_torque_writes_are_repaired_from_the_read_back() {
     let mut rig = Rig::new();
     // Servo 3 misses the SYNC WRITE of the move (a collision on the wire).
-    rig.bus.servo(3).deaf_to = 1;
+    rig.bus.servo(3).lose_next_writes(1);
     let mut data = be(&[1000, 1000, 1000, 0, 0, 0]);
     data.push(100);
     assert_eq!(rig.ask(SEND_ANGLES, &data), [1]);
     rig.run_ms(1500);
     assert!(close(&angles(&mut rig)[..3], &[1000, 1000, 1000], 10));
     // Servo 2 misses the torque-off of release all servos.
-    rig.bus.servo(2).deaf_to = 1;
+    rig.bus.servo(2).lose_next_writes(1);
     assert_eq!(rig.ask(0x13, &[]), [1]);
     rig.run_ms(30);
-    assert!(!rig.bus.servo(2).torque_on(), "torque-off re-sent");
+    assert!(!rig.bus.servo(2).torque_enabled(), "torque-off re-sent");
     assert_eq!(rig.ask(0x10, &[]), [1]);
     rig.run_ms(30);
-    assert!(rig.bus.servo(2).torque_on());
+    assert!(rig.bus.servo(2).torque_enabled());
 }
 
 #[test]
 fn power_on_before_the_first_state_read_does_not_move_the_arm() {
     // The real arm: unpowered at boot, joints somewhere away from zero; the Basic sends power
     // on at once.
-    let mut bus = support::FakeBus::new(true);
-    bus.servo(2).position = 2500.0;
-    bus.servo(2).table[40] = 0;
+    let mut bus = support::ArmBus::new(true);
+    bus.servo(2).move_by_hand(2500);
     let mut rig = Rig {
         atom: firmware_atom::Atom::new(firmware_atom::AtomConfig::default()),
         bus,
@@ -466,13 +470,7 @@ fn power_on_before_the_first_state_read_does_not_move_the_arm() {
         (enc[1] - 2500).abs() <= 2,
         "joint 2 stayed where it was: {enc:?}"
     );
-    assert!(
-        rig.bus
-            .servo(2)
-            .goals
-            .iter()
-            .all(|&g| (g - 2500).abs() <= 2)
-    );
+    assert!(rig.bus.goals[1].iter().all(|&g| (g - 2500).abs() <= 2));
 }
 
 #[test]

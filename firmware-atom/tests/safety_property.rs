@@ -109,12 +109,12 @@ proptest! {
             rig.run_ms(3);
         }
         rig.run_ms(100);
-        for (j, (servo, limit)) in rig.bus.servos.iter().zip(&DEFAULT_LIMITS).enumerate() {
-            for &g in &servo.goals {
+        for (j, (goals, limit)) in rig.bus.goals.iter().zip(&DEFAULT_LIMITS).enumerate() {
+            for &g in goals {
                 prop_assert!(within(limit, g, &config, j), "joint {} goal {}", j + 1, g);
             }
         }
-        for &g in &rig.bus.servos[6].goals {
+        for &g in &rig.bus.goals[6] {
             prop_assert!((0..4096).contains(&g), "gripper goal {}", g);
         }
     }

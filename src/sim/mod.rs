@@ -32,8 +32,8 @@
 //! ```
 
 mod robot;
-pub mod servo;
-pub mod wire;
+
+pub use sim_hw::{servo, wire};
 
 pub use robot::{
     AskError, HostLink, POLL_PERIOD_NS, RobotConfig, SERVO_IDS, SimBasicIo, VirtualRobot,

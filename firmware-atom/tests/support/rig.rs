@@ -1,4 +1,4 @@
-//! A test rig: the Atom, the fake bus with servos, a USB link and recording IO, under virtual
+//! A test rig: the Atom, the simulated bus with servos, a USB link and recording IO, under virtual
 //! time, with a request/reply helper that behaves like the Basic (waits for a quiet wire).
 #![allow(
     dead_code,
@@ -11,14 +11,14 @@ use firmware_atom::{Atom, AtomConfig, RecordingIo};
 use protocol_core::Frame;
 use protocol_core::timing::BUS_QUIET_BEFORE_SEND_US;
 
-use super::{FakeBus, FakeUsb};
+use super::{ArmBus, FakeUsb};
 
 /// Poll period of the rig, microseconds (the contract: at least every 10 us).
 pub const TICK_US: u64 = 5;
 
 pub struct Rig {
     pub atom: Atom,
-    pub bus: FakeBus,
+    pub bus: ArmBus,
     pub usb: FakeUsb,
     pub io: RecordingIo,
 }
@@ -35,10 +35,16 @@ impl Rig {
         )
     }
 
+    /// An arm with `config` (its servos powered if `config.powered_at_boot`) and the Atom
+    /// hearing its own echo if `echo`, after the first refresh rounds.
     pub fn with(config: AtomConfig, echo: bool) -> Self {
+        let mut bus = ArmBus::new(echo);
+        if config.powered_at_boot {
+            bus.power_servos();
+        }
         let mut rig = Self {
             atom: Atom::new(config),
-            bus: FakeBus::new(echo),
+            bus,
             usb: FakeUsb::default(),
             io: RecordingIo::default(),
         };
@@ -47,19 +53,21 @@ impl Rig {
     }
 
     pub fn now(&self) -> u64 {
-        self.bus.now_us
+        self.bus.now_us()
     }
 
+    /// Runs the wire and servos for one poll period, then polls the Atom.
     pub fn tick(&mut self) {
-        self.bus.now_us += TICK_US;
-        let now = self.bus.now_us;
+        let now = self.now() + TICK_US;
+        self.bus.run_until(now * 1_000);
         self.atom
-            .poll(now, &mut self.bus, &mut self.usb, &mut self.io);
+            .poll(now, &mut self.bus.atom_port(), &mut self.usb, &mut self.io);
+        self.bus.start_transmissions();
     }
 
     pub fn run_us(&mut self, us: u64) {
-        let end = self.bus.now_us + us;
-        while self.bus.now_us < end {
+        let end = self.now() + us;
+        while self.now() < end {
             self.tick();
         }
     }
@@ -85,9 +93,8 @@ impl Rig {
             while self.now() < deadline {
                 self.tick();
                 if self.now() <= end + TICK_US && self.atom_talked_between(start, end) {
-                    // Both started on the same quiet wire: the real Basic sees its echo
-                    // differ and sends again once the wire is quiet (the fake does not garble
-                    // overlapping bytes, so the rig plays that part).
+                    // Both started on the same quiet wire and garbled each other: the real
+                    // Basic sees its echo differ and sends again once the wire is quiet.
                     while self.now() <= end + 2 * TICK_US {
                         self.tick();
                     }

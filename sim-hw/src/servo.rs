@@ -150,6 +150,10 @@ pub struct SimServo {
     replies: VecDeque<(u64, Vec<u8>)>,
     registered: Option<(u8, Vec<u8>)>,
     faults: Faults,
+    /// Answers still to send with a wrong checksum ([`SimServo::corrupt_next_answers`]).
+    answers_to_corrupt: u32,
+    /// Writes still to miss ([`SimServo::lose_next_writes`]).
+    writes_to_lose: u32,
     stats: ServoStats,
 }
 
@@ -166,6 +170,8 @@ impl SimServo {
             replies: VecDeque::new(),
             registered: None,
             faults: Faults::NONE,
+            answers_to_corrupt: 0,
+            writes_to_lose: 0,
             stats: ServoStats::default(),
         };
         servo.factory_reset(id);
@@ -282,6 +288,19 @@ impl SimServo {
         self.update_present_registers();
     }
 
+    /// Sends the next `count` answers with a wrong checksum, then healthy ones again: a
+    /// transient disturbance of its replies (for a permanent one use [`Faults::bad_checksum`]).
+    pub fn corrupt_next_answers(&mut self, count: u32) {
+        self.answers_to_corrupt = count;
+    }
+
+    /// Misses the next `count` write instructions addressed to it (WRITE, REG WRITE, or its part
+    /// of a SYNC WRITE), as when a collision garbles them on the wire only where this servo
+    /// sits; reads and pings are still obeyed.
+    pub fn lose_next_writes(&mut self, count: u32) {
+        self.writes_to_lose = count;
+    }
+
     /// What this servo did so far.
     pub fn stats(&self) -> ServoStats {
         self.stats
@@ -305,7 +324,7 @@ impl SimServo {
 
     /// Runs the servo up to `now_ns` on its own: moves the shaft, decodes the bytes it heard on
     /// `port` (call this at every byte end, so each byte is heard at its own time), obeys them,
-    /// and queues on `port` the replies due by now. [`crate::sim::VirtualRobot`] instead decodes
+    /// and queues on `port` the replies due by now. The virtual robot (`open_mycobot::sim::VirtualRobot`) instead decodes
     /// the bus once for all servos with a [`PacketListener`] and calls [`SimServo::receive`] and
     /// [`SimServo::transmit_due`].
     pub fn poll(&mut self, now_ns: u64, port: &mut impl BytePort) {
@@ -465,6 +484,15 @@ impl SimServo {
         let Ok(instr) = Instruction::parse(packet) else {
             return;
         };
+        let is_write = match instr {
+            Instruction::Write { .. } | Instruction::RegWrite { .. } => true,
+            Instruction::SyncWrite { .. } => instr.sync_write_data_for(id).is_some(),
+            _ => false,
+        };
+        if is_write && self.writes_to_lose > 0 {
+            self.writes_to_lose -= 1;
+            return;
+        }
         self.stats.instructions += 1;
         let answers_all = self.reg(reg::STATUS_RETURN_LEVEL) >= 1 && !broadcast;
         match instr {
@@ -525,9 +553,9 @@ impl SimServo {
             return;
         };
         let mut bytes = packet.to_bytes().to_vec();
-        if self.faults.bad_checksum
-            && let Some(chk) = bytes.last_mut()
-        {
+        let corrupt = self.faults.bad_checksum || self.answers_to_corrupt > 0;
+        self.answers_to_corrupt = self.answers_to_corrupt.saturating_sub(1);
+        if corrupt && let Some(chk) = bytes.last_mut() {
             *chk ^= 0x5A;
         }
         let start = heard_ns + PROCESSING_NS + u64::from(self.reg(reg::RETURN_DELAY)) * 2_000;
@@ -612,7 +640,7 @@ impl Default for SimServo {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::wire::{Bus, BusByte, StationId};
+    use crate::wire::{Bus, BusByte, StationId};
     use protocol_core::servo::{SyncWriteBuilder, sign_magnitude};
     use protocol_core::timing::SERVO_TURNAROUND_MAX_US;
 
@@ -1041,6 +1069,43 @@ mod tests {
             "it does send"
         );
         assert!(rig.answers(&trace).is_empty(), "but nothing decodes");
+    }
+
+    #[test]
+    fn corrupted_answers_are_counted_down_then_healthy_again() {
+        let mut rig = Rig::new(&[1]);
+        rig.servo(0).corrupt_next_answers(2);
+        assert!(rig.read(1, reg::PRESENT_POSITION, 2).is_none());
+        assert!(rig.read(1, reg::PRESENT_POSITION, 2).is_none());
+        assert!(
+            rig.read(1, reg::PRESENT_POSITION, 2).is_some(),
+            "third is healthy"
+        );
+    }
+
+    #[test]
+    fn lost_writes_are_missed_but_reads_still_answered() {
+        let mut rig = Rig::new(&[1, 2]);
+        rig.servo(0).lose_next_writes(1);
+        assert!(
+            rig.write(1, reg::ACCELERATION, &[7]).is_empty(),
+            "missed: no answer"
+        );
+        assert_eq!(rig.servo(0).reg(reg::ACCELERATION), 0);
+        assert!(
+            rig.read(1, reg::PRESENT_POSITION, 2).is_some(),
+            "reads still obeyed"
+        );
+        let mut sync = SyncWriteBuilder::new(reg::ACCELERATION, 1);
+        sync.push(1, &[9]).unwrap();
+        sync.push(2, &[9]).unwrap();
+        rig.exchange(&sync.to_packet().unwrap());
+        assert_eq!(
+            rig.servo(0).reg(reg::ACCELERATION),
+            9,
+            "the next write lands"
+        );
+        assert_eq!(rig.servo(1).reg(reg::ACCELERATION), 9);
     }
 
     #[test]

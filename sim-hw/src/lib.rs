@@ -1,0 +1,17 @@
+//! Simulated hardware of the myCobot 280 bus: the shared wire with byte timing and collisions,
+//! serial lines, Feetech STS servos. Used by the virtual robot and by the firmware crates'
+//! tests.
+//!
+//! * [`wire`]: the shared 1 Mbaud half-duplex bus (every station hears every byte, overlapping
+//!   transmissions garble each other, echo per station) and 115200 serial lines.
+//! * [`servo`]: a simulated STS servo: control table, instructions, trapezoidal motion, faults.
+//!
+//! Time is always passed in (nanoseconds); nothing here reads a clock.
+
+#![forbid(unsafe_code)]
+
+pub mod servo;
+pub mod wire;
+
+pub use servo::{Faults, PacketListener, ServoStats, SimServo};
+pub use wire::{Bus, BusByte, HeardByte, SerialLine, StationId};
