@@ -18,7 +18,6 @@ mod board_io;
 mod leds;
 mod pins;
 mod pwm;
-mod uart_port;
 mod ws2812;
 
 use esp_hal::{
@@ -27,8 +26,7 @@ use esp_hal::{
     ledc::{LSGlobalClkSource, Ledc, LowSpeed, channel, timer},
     main,
     rmt::Rmt,
-    rtc_cntl::{Rtc, RwdtStage},
-    time::{Duration, Rate},
+    time::Rate,
     uart::Uart,
 };
 use firmware_atom::{Atom, AtomConfig};
@@ -37,25 +35,10 @@ use protocol_core::timing::BUS_BAUD;
 use crate::{
     board_io::{BoardIo, UserPin},
     leds::{Leds, RMT_TICK_MHZ},
-    uart_port::{UartPort, now_us},
 };
+use board_support::{LoopWatchdog, UartPort, board_log, now_us};
 
 esp_bootloader_esp_idf::esp_app_desc!();
-
-/// The watchdog resets the chip if the loop stalls this long.
-const WATCHDOG_TIMEOUT_MS: u64 = 1_000;
-/// How often the loop feeds the watchdog (feeding is a slow RTC register write).
-const WATCHDOG_FEED_INTERVAL_US: u64 = 100_000;
-
-/// Logs a line on UART0 with `log-uart0`; otherwise only type-checks its arguments.
-macro_rules! board_log {
-    ($($arg:tt)*) => {{
-        #[cfg(feature = "log-uart0")]
-        esp_println::println!($($arg)*);
-        #[cfg(not(feature = "log-uart0"))]
-        let _ = format_args!($($arg)*);
-    }};
-}
 
 #[main]
 fn main() -> ! {
@@ -63,7 +46,7 @@ fn main() -> ! {
     let pins = pins::take_pins!(p);
     board_log!("open-mycobot atom {}", env!("CARGO_PKG_VERSION"));
 
-    let bus_uart = Uart::new(p.UART1, uart_port::config(BUS_BAUD))
+    let bus_uart = Uart::new(p.UART1, board_support::uart_port::config(BUS_BAUD))
         .unwrap_or_else(|_| panic!("bus UART configuration refused"))
         .with_tx(pins.bus_tx)
         .with_rx(pins.bus_rx);
@@ -72,7 +55,7 @@ fn main() -> ! {
     #[cfg(not(feature = "log-uart0"))]
     let mut usb = {
         use protocol_core::timing::HOST_BAUD;
-        let usb_uart = Uart::new(p.UART0, uart_port::config(HOST_BAUD))
+        let usb_uart = Uart::new(p.UART0, board_support::uart_port::config(HOST_BAUD))
             .unwrap_or_else(|_| panic!("USB UART configuration refused"))
             .with_tx(pins.usb_tx)
             .with_rx(pins.usb_rx);
@@ -109,21 +92,12 @@ fn main() -> ! {
         board_log!("configuration refused, running defaults: {:?}", error);
     }
 
-    let mut rtc = Rtc::new(p.RTC_TIMER);
-    rtc.rwdt.set_timeout(
-        RwdtStage::Stage0,
-        Duration::from_millis(WATCHDOG_TIMEOUT_MS),
-    );
-    rtc.rwdt.enable();
-    let mut fed_at_us = now_us();
+    let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, now_us());
 
     loop {
         let now = now_us();
         atom.poll(now, &mut bus, &mut usb, &mut io);
-        if now.wrapping_sub(fed_at_us) >= WATCHDOG_FEED_INTERVAL_US {
-            rtc.rwdt.feed();
-            fed_at_us = now;
-        }
+        watchdog.pass(now);
     }
 }
 
@@ -158,12 +132,4 @@ fn user_pin(pin: AnyPin<'static>, ledc: &Ledc<'static>, index: u8) -> UserPin<'s
         channel,
         signal,
     }
-}
-
-/// Nothing reachable from received bytes panics (the libraries are tested for it); a panic
-/// here is a firmware bug, and a restart is the quickest way back to a working arm.
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    board_log!("panic: {}", info);
-    esp_hal::system::software_reset()
 }

@@ -19,7 +19,6 @@ mod board_io;
 mod pins;
 mod screen;
 mod screen_text;
-mod uart_port;
 
 use embedded_graphics::{pixelcolor::Rgb565, prelude::*};
 use embedded_hal::digital::OutputPin;
@@ -29,12 +28,11 @@ use esp_hal::{
     delay::Delay,
     gpio::{Level, Output, OutputConfig},
     main,
-    rtc_cntl::{Rtc, RwdtStage},
     spi::{
         Mode,
         master::{Config as SpiConfig, Spi},
     },
-    time::{Duration, Rate},
+    time::Rate,
     uart::Uart,
 };
 use firmware_basic::{Basic, BasicConfig};
@@ -46,32 +44,15 @@ use mipidsi::{
 };
 use protocol_core::timing::{BUS_BAUD, HOST_BAUD};
 
-use crate::{
-    board_io::BoardIo,
-    screen::StatusScreen,
-    uart_port::{UartPort, now_us},
-};
+use crate::{board_io::BoardIo, screen::StatusScreen};
+use board_support::{LoopWatchdog, UartPort, board_log, now_us};
 
 esp_bootloader_esp_idf::esp_app_desc!();
 
-/// The watchdog resets the chip if the loop stalls this long.
-const WATCHDOG_TIMEOUT_MS: u64 = 1_000;
-/// How often the loop feeds the watchdog (feeding is a slow RTC register write).
-const WATCHDOG_FEED_INTERVAL_US: u64 = 100_000;
 /// LCD SPI clock: the ILI9342C's write limit on the M5Stack Basic.
 const LCD_SPI_MHZ: u32 = 40;
 /// Bytes mipidsi batches per SPI write.
 const LCD_BUFFER_BYTES: usize = 512;
-
-/// Logs a line on UART0 with `log-uart0`; otherwise only type-checks its arguments.
-macro_rules! board_log {
-    ($($arg:tt)*) => {{
-        #[cfg(feature = "log-uart0")]
-        esp_println::println!($($arg)*);
-        #[cfg(not(feature = "log-uart0"))]
-        let _ = format_args!($($arg)*);
-    }};
-}
 
 #[main]
 fn main() -> ! {
@@ -110,12 +91,12 @@ fn main() -> ! {
         board_log!("LCD did not initialise; running without a status screen");
     }
 
-    let host_uart = Uart::new(p.UART0, uart_port::config(HOST_BAUD))
+    let host_uart = Uart::new(p.UART0, board_support::uart_port::config(HOST_BAUD))
         .unwrap_or_else(|_| panic!("host UART configuration refused"))
         .with_tx(pins.host_tx)
         .with_rx(pins.host_rx);
     let mut host = UartPort::new(host_uart, HOST_BAUD);
-    let bus_uart = Uart::new(p.UART1, uart_port::config(BUS_BAUD))
+    let bus_uart = Uart::new(p.UART1, board_support::uart_port::config(BUS_BAUD))
         .unwrap_or_else(|_| panic!("bus UART configuration refused"))
         .with_tx(pins.bus_tx)
         .with_rx(pins.bus_rx);
@@ -124,13 +105,7 @@ fn main() -> ! {
 
     let mut basic = Basic::new(BasicConfig::default());
 
-    let mut rtc = Rtc::new(p.RTC_TIMER);
-    rtc.rwdt.set_timeout(
-        RwdtStage::Stage0,
-        Duration::from_millis(WATCHDOG_TIMEOUT_MS),
-    );
-    rtc.rwdt.enable();
-    let mut fed_at_us = now_us();
+    let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, now_us());
 
     loop {
         let now = now_us();
@@ -139,17 +114,6 @@ fn main() -> ! {
             screen.update(now, basic.status());
             screen.draw_next();
         }
-        if now.wrapping_sub(fed_at_us) >= WATCHDOG_FEED_INTERVAL_US {
-            rtc.rwdt.feed();
-            fed_at_us = now;
-        }
+        watchdog.pass(now);
     }
-}
-
-/// Nothing reachable from received bytes panics (the libraries are tested for it); a panic
-/// here is a firmware bug, and a restart is the quickest way back to a working transponder.
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    board_log!("panic: {}", info);
-    esp_hal::system::software_reset()
 }
