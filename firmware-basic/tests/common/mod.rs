@@ -1,188 +1,183 @@
-//! A simulated Basic board for tests and benchmarks: a host link and a shared bus with byte
-//! timing, a scripted Atom, other stations that inject traffic, and virtual time.
+//! A simulated Basic board for tests and benchmarks: a host link and the shared bus of `sim-hw`
+//! (byte timing, echo, collisions), a scripted Atom, other stations that inject traffic, and
+//! virtual time.
 //!
-//! The bus is modelled as a list of byte transmissions with start and end times. Two
-//! transmissions that overlap corrupt each other (every listener hears the byte XOR 0xA5).
-//! The Basic hears everything the others send, and its own bytes when `echo` is on.
+//! Two transmissions that overlap on the bus garble each other for every listener. The Basic
+//! hears everything the others send, and its own bytes when `echo` is on; the scripted Atom
+//! listens to the Basic.
 #![allow(dead_code, clippy::unwrap_used, clippy::indexing_slicing)]
 
-use std::cell::RefCell;
 use std::collections::VecDeque;
-use std::rc::Rc;
 
 use firmware_basic::{Basic, BasicConfig, BasicIo, Buttons};
 use protocol_core::{BytePort, Frame, FrameDecoder, timing};
+use sim_hw::{Bus, HeardByte, StationId};
 
 /// Nanoseconds of one byte on the bus.
 pub const BUS_BYTE_NS: u64 = timing::wire_time_ns(1, timing::BUS_BAUD);
 /// Nanoseconds of one byte on the host link.
 pub const HOST_BYTE_NS: u64 = timing::wire_time_ns(1, timing::HOST_BAUD);
 
-/// Who put a byte on the bus.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Station {
-    /// The Basic under test.
-    Basic,
-    /// Anyone else (the Atom, servos, noise).
-    Other,
-}
-
-#[derive(Clone, Copy, Debug)]
-struct Tx {
-    station: Station,
-    start_ns: u64,
-    byte: u8,
-    heard_by_basic: bool,
-    heard_by_atom: bool,
-}
-
-impl Tx {
-    fn end_ns(&self) -> u64 {
-        self.start_ns + BUS_BYTE_NS
-    }
-}
-
-/// The shared wire.
-#[derive(Default)]
+/// The shared wire: `sim-hw`'s bus with the Basic, the scripted Atom and other stations
+/// (servo traffic, noise) attached.
 pub struct Wire {
+    bus: Bus,
     now_ns: u64,
-    txs: Vec<Tx>,
-    /// Whether the Basic hears its own bytes.
-    pub echo: bool,
-    basic_rx: VecDeque<u8>,
-    basic_tx_busy_until_ns: u64,
+    basic: StationId,
+    atom: StationId,
+    /// Transmitters of injected traffic, each with the end (ns) of what it was given, so that
+    /// bursts that overlap in time come from different stations and collide as on a real wire.
+    injectors: Vec<(StationId, u64)>,
+    /// Injected bursts waiting for their start: (start ns, station, bytes), by start.
+    scheduled: VecDeque<(u64, StationId, Vec<u8>)>,
+    heard: Vec<HeardByte>,
+    /// Who sent the last byte that ended on the wire.
+    last_from: Option<StationId>,
     /// Bytes the Basic transmitted, with their start time in ns.
     pub basic_sent: Vec<(u64, u8)>,
-    /// Bytes the Atom heard from others, for its decoder.
+    /// Bytes the Atom heard from the Basic, with their end time in ns, for its decoder.
     atom_rx: VecDeque<(u64, u8)>,
-    /// End time (ns) of the last byte anybody sent.
-    last_end_ns: u64,
+    /// The Atom's answers waiting for a free wire: (earliest start ns, bytes).
+    atom_outbox: VecDeque<(u64, Vec<u8>)>,
+    /// When the Atom tries its waiting answer again, ns.
+    atom_retry_ns: Option<u64>,
 }
 
 impl Wire {
-    /// Schedules `bytes` from another station, back to back from `start_ns`.
+    fn new(echo: bool) -> Self {
+        let mut bus = Bus::mycobot(11);
+        bus.set_tap(true);
+        bus.set_tracing(true);
+        let basic = bus.attach(echo);
+        let atom = bus.attach_transmitter();
+        Self {
+            bus,
+            now_ns: 0,
+            basic,
+            atom,
+            injectors: Vec::new(),
+            scheduled: VecDeque::new(),
+            heard: Vec::new(),
+            last_from: None,
+            basic_sent: Vec::new(),
+            atom_rx: VecDeque::new(),
+            atom_outbox: VecDeque::new(),
+            atom_retry_ns: None,
+        }
+    }
+
+    /// Schedules `bytes` from another station, back to back from `start_ns` (or from now, if
+    /// that has passed).
     pub fn inject(&mut self, start_ns: u64, bytes: &[u8]) {
-        for (i, &byte) in bytes.iter().enumerate() {
-            self.push_tx(Tx {
-                station: Station::Other,
-                start_ns: start_ns + i as u64 * BUS_BYTE_NS,
-                byte,
-                heard_by_basic: false,
-                heard_by_atom: true,
-            });
-        }
-    }
-
-    fn push_tx(&mut self, tx: Tx) {
-        self.last_end_ns = self.last_end_ns.max(tx.end_ns());
-        let pos = self.txs.partition_point(|t| t.start_ns <= tx.start_ns);
-        self.txs.insert(pos, tx);
-    }
-
-    /// What a listener hears for transmission `i`: the byte, or garbage if it overlapped.
-    fn heard(&self, i: usize) -> u8 {
-        let t = self.txs[i];
-        let overlaps = self
-            .txs
-            .iter()
-            .enumerate()
-            .any(|(j, o)| j != i && o.start_ns < t.end_ns() && t.start_ns < o.end_ns());
-        if overlaps { t.byte ^ 0xA5 } else { t.byte }
-    }
-
-    /// Moves every byte whose end has passed to its listeners.
-    fn advance(&mut self, now_ns: u64) {
-        self.now_ns = now_ns;
-        for i in 0..self.txs.len() {
-            let t = self.txs[i];
-            if t.end_ns() > now_ns {
-                // Sorted by start and all the same length, so sorted by end too.
-                break;
+        let start_ns = start_ns.max(self.now_ns);
+        let end_ns = start_ns + bytes.len() as u64 * BUS_BYTE_NS;
+        let free = self
+            .injectors
+            .iter_mut()
+            .find(|(_, busy_until)| *busy_until <= start_ns);
+        let station = match free {
+            Some((id, busy_until)) => {
+                *busy_until = end_ns;
+                *id
             }
-            if !t.heard_by_basic {
-                self.txs[i].heard_by_basic = true;
-                if t.station == Station::Other || self.echo {
-                    let b = self.heard(i);
-                    self.basic_rx.push_back(b);
-                }
+            None => {
+                let id = self.bus.attach_transmitter();
+                self.injectors.push((id, end_ns));
+                id
             }
-            if !t.heard_by_atom {
-                self.txs[i].heard_by_atom = true;
-                let b = self.heard(i);
-                self.atom_rx.push_back((t.end_ns(), b));
-            }
-        }
-        // Forget bytes long past: nothing new can overlap them.
-        let horizon = now_ns.saturating_sub(10 * BUS_BYTE_NS);
-        let keep_from = self
-            .txs
-            .iter()
-            .position(|t| t.end_ns() > horizon || !t.heard_by_basic || !t.heard_by_atom)
-            .unwrap_or(self.txs.len());
-        self.txs.drain(..keep_from);
-    }
-
-    /// The first time from `from_ns` at which the Atom can put `n` bytes on the wire without
-    /// touching traffic already scheduled: it leaves the quiet time around other stations'
-    /// traffic, and may answer the Basic right after its request.
-    pub fn free_slot(&self, from_ns: u64, n: usize) -> u64 {
-        let mut start = from_ns;
-        loop {
-            let end = start + n as u64 * BUS_BYTE_NS;
-            let clash = self
-                .txs
-                .iter()
-                .filter(|t| {
-                    let quiet_ns = match t.station {
-                        Station::Basic => 0,
-                        Station::Other => timing::BUS_QUIET_BEFORE_SEND_US * 1_000,
-                    };
-                    t.start_ns < end + quiet_ns && start < t.end_ns() + quiet_ns
-                })
-                .map(Tx::end_ns)
-                .max();
-            match clash {
-                Some(busy_until) => start = busy_until + timing::BUS_QUIET_BEFORE_SEND_US * 1_000,
-                None => return start,
-            }
-        }
+        };
+        let pos = self.scheduled.partition_point(|(t, _, _)| *t <= start_ns);
+        self.scheduled
+            .insert(pos, (start_ns, station, bytes.to_vec()));
     }
 
     /// Time the wire has been silent, in ns (0 while somebody transmits).
     pub fn quiet_ns(&self) -> u64 {
-        self.now_ns.saturating_sub(self.last_end_ns)
-    }
-}
-
-/// The Basic's bus port: a view of the shared wire.
-#[derive(Clone, Default)]
-pub struct BusPort(pub Rc<RefCell<Wire>>);
-
-impl BytePort for BusPort {
-    fn read_byte(&mut self) -> Option<u8> {
-        self.0.borrow_mut().basic_rx.pop_front()
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        let mut w = self.0.borrow_mut();
-        let start = w.now_ns.max(w.basic_tx_busy_until_ns);
-        for (i, &byte) in bytes.iter().enumerate() {
-            let start_ns = start + i as u64 * BUS_BYTE_NS;
-            w.basic_sent.push((start_ns, byte));
-            w.push_tx(Tx {
-                station: Station::Basic,
-                start_ns,
-                byte,
-                heard_by_basic: false,
-                heard_by_atom: false,
-            });
+        if self.bus.busy() {
+            0
+        } else {
+            self.now_ns.saturating_sub(self.bus.last_activity_ns())
         }
-        w.basic_tx_busy_until_ns = start + bytes.len() as u64 * BUS_BYTE_NS;
     }
 
-    fn tx_idle(&self) -> bool {
-        let w = self.0.borrow();
-        w.now_ns >= w.basic_tx_busy_until_ns
+    /// The next instant the wire needs attention: a byte ends, a burst starts, the Atom tries
+    /// to send.
+    fn next_event_ns(&self) -> Option<u64> {
+        [
+            self.bus.next_event_ns(),
+            self.scheduled.front().map(|(t, _, _)| *t),
+            self.atom_retry_ns,
+        ]
+        .into_iter()
+        .flatten()
+        .min()
+    }
+
+    /// Moves to `now_ns`: bytes that ended arrive, injected bursts that are due are queued.
+    fn arrive(&mut self, now_ns: u64) {
+        self.now_ns = now_ns;
+        self.bus.deliver(now_ns);
+        self.bus.take_heard(&mut self.heard);
+        for h in self.heard.drain(..) {
+            self.last_from = Some(h.from);
+            if h.from == self.basic {
+                self.atom_rx.push_back((h.end_ns, h.byte));
+            }
+        }
+        while let Some((_, station, bytes)) = self.scheduled.pop_front_if(|(t, _, _)| *t <= now_ns)
+        {
+            self.bus.port(station).unwrap().write(&bytes);
+        }
+    }
+
+    /// Starts the bytes queued at the current instant.
+    fn start_transmissions(&mut self) {
+        self.bus.start_transmissions(self.now_ns);
+        for b in self.bus.take_trace() {
+            if b.from == self.basic {
+                self.basic_sent.push((b.start_ns, b.byte));
+            }
+        }
+    }
+
+    /// The Atom sends its waiting answer once its time has come and the wire is free: it may
+    /// answer the Basic right after its request, but leaves the quiet time around other
+    /// stations' traffic (heard, or scheduled to start). Returns what it started, with when.
+    fn atom_try_send(&mut self) -> Option<(u64, Vec<u8>)> {
+        self.atom_retry_ns = None;
+        let (earliest, bytes) = self.atom_outbox.front()?;
+        let now = self.now_ns;
+        if self.bus.busy() {
+            // Tried again at the next byte end.
+            self.atom_retry_ns = Some(*earliest).filter(|&t| t > now);
+            return None;
+        }
+        let quiet = timing::BUS_QUIET_BEFORE_SEND_US * 1_000;
+        let after_others = if self.last_from.is_some_and(|f| f != self.basic) {
+            self.bus.last_activity_ns() + quiet
+        } else {
+            0
+        };
+        let end = now + bytes.len() as u64 * BUS_BYTE_NS;
+        let clash = self
+            .scheduled
+            .iter()
+            .map(|(t, _, b)| (*t, *t + b.len() as u64 * BUS_BYTE_NS))
+            .filter(|&(start, stop)| start < end + quiet && now < stop + quiet)
+            .map(|(_, stop)| stop + quiet)
+            .max()
+            .unwrap_or(0);
+        let ready = (*earliest).max(after_others).max(clash);
+        if ready > now {
+            self.atom_retry_ns = Some(ready);
+            return None;
+        }
+        let (_, bytes) = self.atom_outbox.pop_front()?;
+        self.bus.port(self.atom).unwrap().write(&bytes);
+        if let Some((earliest, _)) = self.atom_outbox.front() {
+            self.atom_retry_ns = Some((*earliest).max(now + 1));
+        }
+        Some((now, bytes))
     }
 }
 
@@ -297,8 +292,8 @@ pub struct Rig {
     pub basic: Basic,
     /// The host link.
     pub host: HostPort,
-    /// The Basic's view of the bus.
-    pub bus: BusPort,
+    /// The shared bus.
+    wire: Wire,
     /// The Basic's pins.
     pub io: MemIo,
     /// Virtual time, ns.
@@ -320,12 +315,10 @@ pub struct Rig {
 impl Rig {
     /// A rig with `config`, an echoing or silent wire, and an Atom that acks everything.
     pub fn new(config: BasicConfig, echo: bool) -> Self {
-        let bus = BusPort::default();
-        bus.0.borrow_mut().echo = echo;
         Self {
             basic: Basic::new(config),
             host: HostPort::default(),
-            bus,
+            wire: Wire::new(echo),
             io: MemIo::default(),
             now_ns: 0,
             step_ns: 1_000,
@@ -351,22 +344,39 @@ impl Rig {
     }
 
     /// The wire.
-    pub fn wire(&self) -> std::cell::RefMut<'_, Wire> {
-        self.bus.0.borrow_mut()
+    pub fn wire(&mut self) -> &mut Wire {
+        &mut self.wire
     }
 
-    /// One poll at the current time, then time moves on by one step.
+    /// One poll at the current time (after the wire has run up to it), then time moves on by
+    /// one step.
     pub fn step(&mut self) {
-        self.wire().advance(self.now_ns);
-        self.host.now_ns = self.now_ns;
+        while let Some(t) = self.wire.next_event_ns().filter(|&t| t < self.now_ns) {
+            self.wire_instant(t);
+        }
+        self.wire.arrive(self.now_ns);
         self.run_atom();
-        self.basic.poll(
-            self.now_ns / 1_000,
-            &mut self.host,
-            &mut self.bus,
-            &mut self.io,
-        );
+        self.host.now_ns = self.now_ns;
+        let mut bus = self.wire.bus.port(self.wire.basic).unwrap();
+        self.basic
+            .poll(self.now_ns / 1_000, &mut self.host, &mut bus, &mut self.io);
+        self.atom_send();
+        self.wire.start_transmissions();
         self.now_ns += self.step_ns;
+    }
+
+    /// An instant between polls: bytes arrive, the Atom answers, transmitters start.
+    fn wire_instant(&mut self, t_ns: u64) {
+        self.wire.arrive(t_ns);
+        self.run_atom();
+        self.atom_send();
+        self.wire.start_transmissions();
+    }
+
+    fn atom_send(&mut self) {
+        if let Some(sent) = self.wire.atom_try_send() {
+            self.atom_sent.push(sent);
+        }
     }
 
     /// Runs for `us` microseconds of virtual time.
@@ -390,7 +400,7 @@ impl Rig {
     }
 
     fn run_atom(&mut self) {
-        let heard: Vec<(u64, u8)> = self.wire().atom_rx.drain(..).collect();
+        let heard: Vec<(u64, u8)> = self.wire.atom_rx.drain(..).collect();
         let mut frames = Vec::new();
         for (at, b) in heard {
             if at.saturating_sub(self.atom_last_rx_ns) > timing::BUS_FRAME_GAP_US * 1_000 {
@@ -402,9 +412,9 @@ impl Rig {
         for (at, frame) in frames {
             self.atom_got.push((at, frame.clone()));
             if let Some(reply) = (self.atom)(&frame) {
-                let start = self.wire().free_slot(at + self.atom_delay_ns, reply.len());
-                self.wire().inject(start, &reply);
-                self.atom_sent.push((start, reply));
+                self.wire
+                    .atom_outbox
+                    .push_back((at + self.atom_delay_ns, reply));
             }
         }
     }
