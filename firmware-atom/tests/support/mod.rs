@@ -99,11 +99,6 @@ impl ArmBus {
         &mut self.servos[usize::from(id) - 1].1
     }
 
-    /// The servos in id order.
-    pub fn servos(&self) -> impl Iterator<Item = &SimServo> {
-        self.servos.iter().map(|(_, s)| s)
-    }
-
     /// Switches every servo's torque on without a word on the wire: an arm powered before the
     /// Atom booted.
     pub fn power_servos(&mut self) {
