@@ -280,7 +280,8 @@ pub enum Request {
     },
     /// 0x51 are all servos enabled.
     AreAllServosEnabled,
-    /// 0x52 write a servo register: LEN 5 one byte, LEN 7 two bytes (trailing `01`).
+    /// 0x52 write a servo register: LEN 5 one byte; LEN 7 a 16-bit value and a width flag
+    /// (`01` two bytes, `00` one byte: the value must fit in it).
     SetServoData {
         /// Servo.
         servo: ServoId,
@@ -881,13 +882,20 @@ impl Request {
                 let servo = f.servo()?;
                 let address = f.address()?;
                 let word = f.i16()? as u16;
-                match f.u8()? {
-                    1 => Self::SetServoData {
+                // pymycobot's `set_servo_data(.., mode)` always sends the value in two bytes
+                // and the flag says the register's width: 1 a word, 0 one byte (the low one).
+                match (f.u8()?, u8::try_from(word)) {
+                    (1, _) => Self::SetServoData {
                         servo,
                         address,
                         value: ServoValue::Word(word),
                     },
-                    v => return Err(CommandError::BadFlag(v)),
+                    (0, Ok(byte)) => Self::SetServoData {
+                        servo,
+                        address,
+                        value: ServoValue::Byte(byte),
+                    },
+                    (v, _) => return Err(CommandError::BadFlag(v)),
                 }
             }
             (cmd::GET_SERVO_DATA, 2 | 3) => Self::GetServoData {
@@ -1520,6 +1528,13 @@ mod tests {
             parse(cmd::SET_SERVO_DATA, &[1, 42, 0x08, 0x00, 1]),
             Ok(Request::SetServoData {
                 value: ServoValue::Word(2048),
+                ..
+            })
+        ));
+        assert!(matches!(
+            parse(cmd::SET_SERVO_DATA, &[1, 21, 0x00, 40, 0]),
+            Ok(Request::SetServoData {
+                value: ServoValue::Byte(40),
                 ..
             })
         ));
