@@ -829,8 +829,9 @@ impl Atom {
 
     /// Where joint `j`, at `present` and moving at its last read speed, comes to rest when it
     /// brakes with acceleration register `accel` (100 steps/s^2 units): `v^2 / 2a` further on,
-    /// kept within the joint's limits. Holding at the present position instead would make a
-    /// fast joint overshoot and swing back (a jog at full speed runs on about 14 degrees).
+    /// kept within the joint's limits (a joint already past a limit stays where it is, it is
+    /// not dragged back to it). Holding at the present position instead would make a fast
+    /// joint overshoot and swing back (a jog at full speed runs on about 14 degrees).
     fn braking_point(&self, j: usize, present: Steps, accel: u8) -> Steps {
         let speed = i64::from(self.health.get(j).map_or(0, |h| h.speed_steps_per_s));
         let decel = i64::from(accel.max(1)) * 100;
@@ -838,7 +839,8 @@ impl Atom {
         let beyond = (i64::from(present.0) + travel).clamp(0, i64::from(STEPS_PER_TURN) - 1);
         let mut angle = self.config.steps_to_angle(j, Steps(beyond as i16));
         if let Some(limit) = self.limits.get(j) {
-            angle = angle.clamp(limit.min, limit.max);
+            let now = self.config.steps_to_angle(j, present);
+            angle = angle.clamp(limit.min.min(now), limit.max.max(now));
         }
         self.goal_steps(j, angle)
     }
@@ -878,6 +880,16 @@ impl Atom {
             JogDirection::Positive => limit.max,
             JogDirection::Negative => limit.min,
         };
+        // A joint already past that limit (the user tightened it) would be dragged backwards,
+        // against the direction asked for: refuse instead.
+        let present = self.present_angles().get(j).copied().unwrap_or(end);
+        let beyond = match direction {
+            JogDirection::Positive => present > end,
+            JogDirection::Negative => present < end,
+        };
+        if beyond {
+            return Err(ActionError::JointLimit(j));
+        }
         let mut angles = [None; JOINTS];
         if let Some(slot) = angles.get_mut(j) {
             *slot = Some(end);
