@@ -8,8 +8,9 @@ use protocol_core::timing::{HOST_BAUD, HOST_REPLY_DEADLINE_US};
 use protocol_core::units::{Centideg, Steps};
 use protocol_core::{Frame, FrameDecoder};
 
-use super::servo::{PacketListener, SimServo};
+use super::servo::SimServo;
 use super::wire::{Bus, HeardByte, SerialLine, SerialPort, StationId};
+use sim_hw::ServoChain;
 
 /// Longest virtual time between two polls of the Basic and the Atom, in ns: one byte time on
 /// the bus, so no station ever misses a byte-time boundary by more than that.
@@ -181,11 +182,6 @@ struct BasicBoard {
     io: SimBasicIo,
 }
 
-struct SimulatedServo {
-    station: StationId,
-    servo: SimServo,
-}
-
 /// Why [`VirtualRobot::ask`] got no usable answer.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum AskError {
@@ -225,9 +221,7 @@ pub struct VirtualRobot {
     atom_station: StationId,
     atom_usb: UsbLink,
     atom_io: RecordingIo,
-    servos: Vec<SimulatedServo>,
-    /// One decoder for all servos: they hear the same bytes.
-    servo_listener: PacketListener,
+    servos: ServoChain,
     heard: Vec<HeardByte>,
     noise_station: StationId,
     next_poll_ns: u64,
@@ -248,13 +242,10 @@ impl VirtualRobot {
             io: SimBasicIo::default(),
         });
         let atom_station = bus.attach(config.atom_hears_echo);
-        let servos = SERVO_IDS
-            .iter()
-            .map(|&id| SimulatedServo {
-                station: bus.attach_transmitter(),
-                servo: SimServo::new(id, config.initial_position_steps),
-            })
-            .collect();
+        let mut servos = ServoChain::new();
+        for &id in &SERVO_IDS {
+            servos.attach(&mut bus, SimServo::new(id, config.initial_position_steps));
+        }
         let noise_station = bus.attach_transmitter();
         bus.set_tap(true);
         Self {
@@ -269,7 +260,6 @@ impl VirtualRobot {
             atom_usb: UsbLink::new(),
             atom_io: RecordingIo::default(),
             servos,
-            servo_listener: PacketListener::default(),
             heard: Vec::new(),
             noise_station,
             next_poll_ns: 0,
@@ -386,9 +376,7 @@ impl VirtualRobot {
                 .as_ref()
                 .and_then(|b| b.main_loop.next_event_ns()),
         );
-        for s in &self.servos {
-            consider(s.servo.next_event_ns());
-        }
+        consider(self.servos.next_event_ns());
         next
     }
 
@@ -408,20 +396,9 @@ impl VirtualRobot {
         }
         self.bus.take_heard(&mut self.heard);
         for heard in self.heard.drain(..) {
-            let servos = &mut self.servos;
-            self.servo_listener
-                .hear(heard.byte, heard.end_ns, |packet| {
-                    // A servo does not hear its own answers.
-                    for s in servos.iter_mut().filter(|s| s.station != heard.from) {
-                        s.servo.receive(&packet, heard.end_ns);
-                    }
-                });
+            self.servos.hear(&heard);
         }
-        for s in &mut self.servos {
-            if let Some(mut port) = self.bus.port(s.station) {
-                s.servo.transmit_due(now_ns, &mut port);
-            }
-        }
+        self.servos.transmit_due(now_ns, &mut self.bus);
         if let Some(basic) = self.basic.as_mut()
             && basic.main_loop.runs_at(now_ns)
             && let Some(mut bus) = self.bus.port(basic.station)
@@ -521,28 +498,22 @@ impl VirtualRobot {
 
     /// The simulated servo with bus id `id` (its present register 5).
     pub fn servo(&self, id: u8) -> Option<&SimServo> {
-        self.servos.iter().map(|s| &s.servo).find(|s| s.id() == id)
+        self.servos.get(id)
     }
 
     /// The simulated servo with bus id `id`, to inject faults or move it by hand.
     pub fn servo_mut(&mut self, id: u8) -> Option<&mut SimServo> {
-        self.servos
-            .iter_mut()
-            .map(|s| &mut s.servo)
-            .find(|s| s.id() == id)
+        self.servos.get_mut(id)
     }
 
     /// Every simulated servo, in the order they were built (ids 1..7 at power-up).
     pub fn servos(&self) -> impl Iterator<Item = &SimServo> {
-        self.servos.iter().map(|s| &s.servo)
+        self.servos.iter()
     }
 
     /// The bus station of the servo built for `id` (for reading a bus trace).
     pub fn servo_station(&self, id: u8) -> Option<StationId> {
-        self.servos
-            .iter()
-            .find(|s| s.servo.id() == id)
-            .map(|s| s.station)
+        self.servos.station(id)
     }
 
     /// The Atom firmware, for inspection.

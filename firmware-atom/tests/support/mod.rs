@@ -16,7 +16,7 @@ use std::collections::VecDeque;
 use protocol_core::servo::{BROADCAST_ID, Instruction, Packet, reg, sign_magnitude};
 use protocol_core::{BytePort, Frame, FrameDecoder};
 use sim_hw::wire::BusPort;
-use sim_hw::{Bus, HeardByte, PacketListener, SimServo, StationId};
+use sim_hw::{Bus, HeardByte, PacketListener, ServoChain, SimServo, StationId};
 
 pub mod rig;
 
@@ -38,8 +38,7 @@ pub struct ArmBus {
     host: StationId,
     /// When the host's transmitter is done with what it was given, ns.
     host_tx_end_ns: u64,
-    servos: Vec<(StationId, SimServo)>,
-    servo_listener: PacketListener,
+    servos: ServoChain,
     heard: Vec<HeardByte>,
     atom_packets: PacketListener,
     atom_frames: FrameDecoder,
@@ -64,9 +63,10 @@ impl ArmBus {
         wire.set_tap(true);
         let atom = wire.attach(echo);
         let host = wire.attach_transmitter();
-        let servos: Vec<_> = SERVO_IDS
-            .map(|id| (wire.attach_transmitter(), SimServo::new(id, 2048)))
-            .collect();
+        let mut servos = ServoChain::new();
+        for id in SERVO_IDS {
+            servos.attach(&mut wire, SimServo::new(id, 2048));
+        }
         Self {
             wire,
             now_ns: 0,
@@ -75,10 +75,9 @@ impl ArmBus {
             host_tx_end_ns: 0,
             goal_bytes: servos
                 .iter()
-                .map(|(_, s)| s.goal_position().to_le_bytes())
+                .map(|s| s.goal_position().to_le_bytes())
                 .collect(),
             servos,
-            servo_listener: PacketListener::default(),
             heard: Vec::new(),
             atom_packets: PacketListener::default(),
             atom_frames: FrameDecoder::new(),
@@ -96,7 +95,7 @@ impl ArmBus {
 
     /// The servo with `id` (1..=7).
     pub fn servo(&mut self, id: u8) -> &mut SimServo {
-        &mut self.servos[usize::from(id) - 1].1
+        self.servos.get_mut(id).unwrap()
     }
 
     /// Switches every servo's torque on without a word on the wire: an arm powered before the
@@ -108,8 +107,8 @@ impl ArmBus {
         }
         .to_packet(BROADCAST_ID)
         .unwrap();
-        for (_, servo) in &mut self.servos {
-            servo.receive(&on, 0);
+        for id in SERVO_IDS {
+            self.servo(id).receive(&on, 0);
         }
     }
 
@@ -145,11 +144,9 @@ impl ArmBus {
     /// Runs the wire and the servos up to `t_ns`, stopping at every byte end and servo answer.
     pub fn run_until(&mut self, t_ns: u64) {
         while self.now_ns < t_ns {
-            let next = self
-                .servos
-                .iter()
-                .filter_map(|(_, s)| s.next_event_ns())
-                .chain(self.wire.next_event_ns())
+            let next = [self.servos.next_event_ns(), self.wire.next_event_ns()]
+                .into_iter()
+                .flatten()
                 .fold(t_ns, u64::min)
                 .max(self.now_ns + 1);
             self.step(next);
@@ -167,20 +164,9 @@ impl ArmBus {
         self.wire.take_heard(&mut self.heard);
         for heard in std::mem::take(&mut self.heard) {
             self.observe(heard);
-            let servos = &mut self.servos;
-            self.servo_listener
-                .hear(heard.byte, heard.end_ns, |packet| {
-                    // A servo does not hear its own answers.
-                    for (_, servo) in servos.iter_mut().filter(|(st, _)| *st != heard.from) {
-                        servo.receive(&packet, heard.end_ns);
-                    }
-                });
+            self.servos.hear(&heard);
         }
-        for (station, servo) in &mut self.servos {
-            if let Some(mut port) = self.wire.port(*station) {
-                servo.transmit_due(now_ns, &mut port);
-            }
-        }
+        self.servos.transmit_due(now_ns, &mut self.wire);
         self.wire.start_transmissions(now_ns);
     }
 
