@@ -13,6 +13,7 @@
 //! Straight-line moves and Cartesian jogs are stepped by [`stepper`].
 
 use heapless::Deque;
+use protocol_core::command::Pose;
 use protocol_core::servo::reg;
 use protocol_core::timing::{
     ATOM_TRANSACTION_GAP_US, BUS_BAUD, BUS_QUIET_BEFORE_SEND_US, HOST_FRAME_GAP_US, wire_time_us,
@@ -104,6 +105,8 @@ pub(crate) struct Target {
     pub angles: [Option<Centideg>; JOINTS],
     /// Speed, percent.
     pub speed_percent: u8,
+    /// `Some`: reach `angles` along a straight line to this pose (send_coords mode 1).
+    pub linear: Option<Pose>,
 }
 
 /// Why an action was not carried out. Converted to the 0x07 error code in one place
@@ -734,6 +737,9 @@ impl Atom {
         jog: bool,
     ) -> Result<(), ActionError> {
         self.check_target(&target)?;
+        if let Some(pose) = target.linear {
+            return self.start_line(now_us, pose, target);
+        }
         let steps: [Option<Steps>; JOINTS] = core::array::from_fn(|j| {
             target
                 .angles
@@ -851,9 +857,21 @@ impl Atom {
             target, jog: false, ..
         } = self.activity
         {
-            self.paused = Some(Target {
-                angles: target.map(Some),
-                speed_percent: self.speed_percent,
+            self.paused = Some(match &self.stepper {
+                Some(Stepper::Line {
+                    target: pose,
+                    speed_percent,
+                    ..
+                }) => Target {
+                    angles: target.map(Some),
+                    speed_percent: *speed_percent,
+                    linear: Some(*pose),
+                },
+                _ => Target {
+                    angles: target.map(Some),
+                    speed_percent: self.speed_percent,
+                    linear: None,
+                },
             });
         }
         self.halt(false);
@@ -901,6 +919,7 @@ impl Atom {
             Target {
                 angles,
                 speed_percent,
+                linear: None,
             },
             true,
         )

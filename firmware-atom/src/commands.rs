@@ -145,6 +145,7 @@ fn execute<I: AtomIo>(
             let target = Target {
                 angles,
                 speed_percent: speed.get(),
+                linear: None,
             };
             Answer::Done(atom.submit_motion(now_us, target))
         }
@@ -153,6 +154,7 @@ fn execute<I: AtomIo>(
             Target {
                 angles: angles.map(Some),
                 speed_percent: speed.get(),
+                linear: None,
             },
         )),
         R::GetCoords => Answer::Now(Reply::Coords(atom.present_coords())),
@@ -248,6 +250,7 @@ fn execute<I: AtomIo>(
                 Target {
                     angles,
                     speed_percent: speed.get(),
+                    linear: None,
                 },
             ))
         }
@@ -290,6 +293,7 @@ fn execute<I: AtomIo>(
                 Target {
                     angles,
                     speed_percent: speed,
+                    linear: None,
                 },
             ))
         }
@@ -311,6 +315,7 @@ fn execute<I: AtomIo>(
                 Target {
                     angles,
                     speed_percent: speed.get(),
+                    linear: None,
                 },
             ))
         }

@@ -76,25 +76,40 @@ impl Atom {
         let target = Target {
             angles: angles.map(Some),
             speed_percent,
+            linear: (mode == MoveMode::Linear).then_some(pose),
         };
-        self.check_target(&target)?;
-        if mode == MoveMode::Joint || !self.fresh_mode && self.activity != Activity::Idle {
-            return self.submit_motion(now_us, target);
-        }
-        let start = cartesian::joints(&self.present_angles());
-        let step = self.linear_step_decimm(speed_percent);
+        // Like any other motion it preempts (fresh mode) or waits its turn (queue mode).
+        self.submit_motion(now_us, target)
+    }
+
+    /// Starts the straight line from the present position to `pose` (whose joint angles are
+    /// `target.angles`).
+    pub(super) fn start_line(
+        &mut self,
+        now_us: u64,
+        pose: Pose,
+        target: Target,
+    ) -> Result<(), ActionError> {
+        let present = self.present_angles();
+        let start = cartesian::joints(&present);
+        let step = self.linear_step_decimm(target.speed_percent);
         let path = LinearPath::new(self.cart.model(), &start, &cartesian::to_kin(&pose), step)
             .map_err(|_| ActionError::Unreachable)?;
-        self.queue.clear();
-        self.paused = None;
         self.stepper = Some(Stepper::Line {
             path,
             next_us: now_us,
             target: pose,
-            speed_percent,
+            speed_percent: target.speed_percent,
         });
         self.activity = Activity::Moving {
-            target: angles,
+            target: core::array::from_fn(|j| {
+                target
+                    .angles
+                    .get(j)
+                    .copied()
+                    .flatten()
+                    .unwrap_or(present.get(j).copied().unwrap_or_default())
+            }),
             started_us: now_us,
             duration_us: u64::MAX / 4,
             jog: false,
@@ -227,6 +242,7 @@ impl Atom {
         self.check_target(&Target {
             angles: q.map(Some),
             speed_percent: 100,
+            linear: None,
         })?;
         let present = self.present_steps();
         let max_speed = u64::from(motion::joint_speed_steps(&self.config, speed_percent));
