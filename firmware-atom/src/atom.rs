@@ -804,7 +804,13 @@ impl Atom {
         }
         let present = self.present_steps();
         let accel = motion::joint_accel_register(&self.config);
-        let speed = motion::joint_speed_steps(&self.config, 100) as u16;
+        let fastest_steps_per_s = self
+            .health
+            .iter()
+            .take(JOINTS)
+            .map(|h| h.speed_steps_per_s.unsigned_abs())
+            .max()
+            .unwrap_or(0);
         let mut goals: GoalSet = [None; SERVOS];
         for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
             // Only servos whose position has been read: at boot the Basic's power on (0x10)
@@ -815,11 +821,7 @@ impl Atom {
                 .get(j)
                 .is_some_and(|h| h.torque_on && h.answering);
             if let (true, Some(&p)) = (torque, present.get(j)) {
-                *slot = Some(Goal {
-                    position: self.braking_point(j, p, accel),
-                    speed_steps_per_s: speed,
-                    accel,
-                });
+                *slot = Some(self.braking_goal(j, p, accel, fastest_steps_per_s));
             }
         }
         // A present position outside the limits (arm moved by hand) is not sent: that joint
@@ -833,22 +835,33 @@ impl Atom {
         }
     }
 
-    /// Where joint `j`, at `present` and moving at its last read speed, comes to rest when it
-    /// brakes with acceleration register `accel` (100 steps/s^2 units): `v^2 / 2a` further on,
-    /// kept within the joint's limits (a joint already past a limit stays where it is, it is
-    /// not dragged back to it). Holding at the present position instead would make a fast
-    /// joint overshoot and swing back (a jog at full speed runs on about 14 degrees).
-    fn braking_point(&self, j: usize, present: Steps, accel: u8) -> Steps {
+    /// The goal that brings joint `j` (at `present`, moving at its last read speed) to rest.
+    ///
+    /// Holding at the present position would make a moving joint overshoot and swing back (a
+    /// jog at full speed runs on about 14 degrees). Instead every joint brakes over the same
+    /// time, the fastest joint's stopping time `T = v_max / a` at the full ramp `accel`
+    /// (100 steps/s^2 units): joint `j` keeps its present speed as goal speed, decelerates at
+    /// `a * |v_j| / v_max` and stops `v_j * T / 2` further on. All joints thus stop together,
+    /// along the path they were on, so a Cartesian jog or line keeps its pose while it stops.
+    /// The stop is kept within the joint's limits (a joint already past a limit stays where it
+    /// is, it is not dragged back to it).
+    fn braking_goal(&self, j: usize, present: Steps, accel: u8, fastest_steps_per_s: u16) -> Goal {
         let speed = i64::from(self.health.get(j).map_or(0, |h| h.speed_steps_per_s));
-        let decel = i64::from(accel.max(1)) * 100;
-        let travel = speed * speed.abs() / (2 * decel);
+        let fastest = i64::from(fastest_steps_per_s.max(1));
+        let full_ramp = i64::from(accel.max(1)) * 100;
+        let travel = speed * fastest / (2 * full_ramp);
+        let ramp = ((i64::from(accel) * speed.abs() + fastest - 1) / fastest).clamp(1, 254) as u8;
         let beyond = (i64::from(present.0) + travel).clamp(0, i64::from(STEPS_PER_TURN) - 1);
         let mut angle = self.config.steps_to_angle(j, Steps(beyond as i16));
         if let Some(limit) = self.limits.get(j) {
             let now = self.config.steps_to_angle(j, present);
             angle = angle.clamp(limit.min.min(now), limit.max.max(now));
         }
-        self.goal_steps(j, angle)
+        Goal {
+            position: self.goal_steps(j, angle),
+            speed_steps_per_s: speed.unsigned_abs().clamp(1, u64::from(u16::MAX)) as u16,
+            accel: ramp,
+        }
     }
 
     /// Pauses the current motion (it can be resumed).
@@ -857,21 +870,11 @@ impl Atom {
             target, jog: false, ..
         } = self.activity
         {
-            self.paused = Some(match &self.stepper {
-                Some(Stepper::Line {
-                    target: pose,
-                    speed_percent,
-                    ..
-                }) => Target {
-                    angles: target.map(Some),
-                    speed_percent: *speed_percent,
-                    linear: Some(*pose),
-                },
-                _ => Target {
-                    angles: target.map(Some),
-                    speed_percent: self.speed_percent,
-                    linear: None,
-                },
+            // A paused straight line resumes as a joint move to its end.
+            self.paused = Some(Target {
+                angles: target.map(Some),
+                speed_percent: self.speed_percent,
+                linear: None,
             });
         }
         self.halt(false);
