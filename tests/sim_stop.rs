@@ -3,7 +3,7 @@
 mod sim_support;
 
 use open_mycobot::sim::VirtualRobot;
-use protocol_core::command::{Direction, JointId, Request};
+use protocol_core::command::{Direction, JointId, Pose, Reply, Request, RpyAxis};
 use protocol_core::units::Centideg;
 use sim_support::*;
 
@@ -87,4 +87,49 @@ fn pause_brakes_a_move_without_swinging_back() {
         degrees([120.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
         "resumed move arrives",
     );
+}
+
+/// Distance in tenths of a millimetre between the flange positions of two poses.
+fn position_distance(a: &Pose, b: &Pose) -> f64 {
+    let d = |p: i16, q: i16| f64::from(p) - f64::from(q);
+    (d(a.x.0, b.x.0).powi(2) + d(a.y.0, b.y.0).powi(2) + d(a.z.0, b.z.0).powi(2)).sqrt()
+}
+
+fn get_coords(robot: &mut VirtualRobot) -> Pose {
+    match ask(robot, Request::GetCoords) {
+        Reply::Coords(pose) => pose,
+        other => panic!("get_coords answered {other:?}"),
+    }
+}
+
+#[test]
+fn stopping_a_rotation_jog_keeps_the_flange_where_it_was() {
+    for axis in [RpyAxis::Roll, RpyAxis::Pitch, RpyAxis::Yaw] {
+        let mut robot = arm();
+        ack(
+            &mut robot,
+            Request::SendAngles {
+                angles: degrees([0.0, -30.0, -60.0, 0.0, 30.0, 0.0]),
+                speed: speed(100),
+            },
+        );
+        wait_until_stopped(&mut robot);
+        let start = get_coords(&mut robot);
+        ack(
+            &mut robot,
+            Request::JogRpy {
+                axis,
+                direction: Direction::Positive,
+                speed: speed(20),
+            },
+        );
+        robot.run_for(1_000_000);
+        ack(&mut robot, Request::Stop);
+        wait_until_stopped(&mut robot);
+        let end = get_coords(&mut robot);
+        assert!(
+            position_distance(&start, &end) <= 10.0,
+            "{axis:?}: the flange moved from {start:?} to {end:?} while rotating and stopping"
+        );
+    }
 }
