@@ -119,6 +119,29 @@ pub fn angles(q: &JointAngles) -> [Centideg; JOINTS] {
     q.0.map(|v| Centideg(sat(v)))
 }
 
+/// Client bounds of x and y, tenths of a millimetre: pymycobot refuses beyond +-281.45 mm.
+const CLIENT_XY_MAX: i16 = 2814;
+/// Client bounds of z, tenths of a millimetre: pymycobot refuses outside -70..412.67 mm.
+const CLIENT_Z_RANGE: (i16, i16) = (-700, 4126);
+
+/// A pose as reported to the host. pymycobot refuses to send coordinates past its bounds
+/// (x, y +-281.45 mm, z -70..412.67 mm), and the arm reaches exactly those bounds (the zero
+/// pose is at z = 412.67 mm, which rounds to 412.7): a value that rounding alone put one wire
+/// unit (0.1 mm) past a bound is reported at the bound, so a pose read back can always be sent
+/// again. Values farther out (a tilted flange above 412.67 mm, a world frame) are reported as
+/// they are.
+pub fn for_client(mut p: Pose) -> Pose {
+    let pull_in = |v: i16, min: i16, max: i16| match v {
+        v if v == max + 1 => max,
+        v if v == min - 1 => min,
+        v => v,
+    };
+    p.x.0 = pull_in(p.x.0, -CLIENT_XY_MAX, CLIENT_XY_MAX);
+    p.y.0 = pull_in(p.y.0, -CLIENT_XY_MAX, CLIENT_XY_MAX);
+    p.z.0 = pull_in(p.z.0, CLIENT_Z_RANGE.0, CLIENT_Z_RANGE.1);
+    p
+}
+
 /// A protocol pose as a kinematics pose.
 pub fn to_kin(p: &Pose) -> kinematics_core::Pose {
     kinematics_core::Pose {
@@ -160,5 +183,22 @@ mod tests {
         assert!((i32::from(p.x.0) - 456).abs() <= 1, "{p:?}");
         assert!((i32::from(p.y.0) + 634).abs() <= 1, "{p:?}");
         assert!((i32::from(p.z.0) - 4127).abs() <= 1, "{p:?}");
+    }
+
+    #[test]
+    fn reported_poses_stay_sendable_but_are_not_clamped_further() {
+        let pose = |x, y, z| Pose {
+            x: DeciMm(x),
+            y: DeciMm(y),
+            z: DeciMm(z),
+            ..Pose::default()
+        };
+        // One wire unit past pymycobot's bounds: rounding, reported at the bound.
+        assert_eq!(for_client(pose(2815, -2815, 4127)), pose(2814, -2814, 4126));
+        assert_eq!(for_client(pose(0, 0, -701)), pose(0, 0, -700));
+        // Inside, or truly outside (a tilted flange, a world frame): unchanged.
+        for p in [pose(2814, 0, 4126), pose(2900, 0, 4250), pose(0, 0, -800)] {
+            assert_eq!(for_client(p), p);
+        }
     }
 }

@@ -16,6 +16,7 @@ use protocol_core::servo::reg;
 use protocol_core::units::{Centideg, Decideg, Steps};
 
 use crate::atom::{ActionError, Atom, Link, Target, Then};
+use crate::cartesian::for_client;
 use crate::config::{GRIPPER, JOINTS, SERVOS};
 use crate::driver::Op;
 use crate::io::{AtomIo, PinMode};
@@ -157,8 +158,10 @@ fn execute<I: AtomIo>(
                 linear: None,
             },
         )),
-        R::GetCoords => Answer::Now(Reply::Coords(atom.present_coords())),
-        R::AnglesToCoords { angles } => Answer::Now(Reply::Coords(atom.cart.forward(&angles))),
+        R::GetCoords => Answer::Now(Reply::Coords(for_client(atom.present_coords()))),
+        R::AnglesToCoords { angles } => {
+            Answer::Now(Reply::Coords(for_client(atom.cart.forward(&angles))))
+        }
         R::SendCoord { target, speed } => {
             let base = atom.planned_coords();
             let pose = base.with(target);
@@ -204,11 +207,11 @@ fn execute<I: AtomIo>(
         },
         R::GetAnglesCoords => {
             let angles = atom.present_angles();
-            let coords = atom.cart.forward(&angles);
+            let coords = for_client(atom.cart.forward(&angles));
             Answer::Now(Reply::AnglesAndCoords { angles, coords })
         }
         R::GetPlannedAngles => Answer::Now(Reply::Angles(atom.planned_angles())),
-        R::GetPlannedCoords => Answer::Now(Reply::Coords(atom.planned_coords())),
+        R::GetPlannedCoords => Answer::Now(Reply::Coords(for_client(atom.planned_coords()))),
         // Vendor demo routines: not supported, refused.
         R::MoveRound | R::SetFourPiecesZero => Answer::Now(Reply::Byte(0)),
 

@@ -16,7 +16,9 @@
 //! * **State** (angles, coords, encoders, speeds, voltages, temperatures, faults) comes from
 //!   the servos: registers 40..=70 of every servo are read in turn (one READ each), about 225
 //!   rounds per second (bench `latency`). Coordinates are the forward kinematics of the present
-//!   angles. The same read gives back each servo's torque and goal registers: a goal or torque
+//!   angles; a value that rounding alone put 0.1 mm past pymycobot's bounds (the zero pose's
+//!   z = 412.67 mm) is reported at the bound, so a pose read back can always be sent again
+//!   ([`cartesian::for_client`]). The same read gives back each servo's torque and goal registers: a goal or torque
 //!   write lost on the shared wire (a SYNC WRITE has no answer) is re-sent, at most 3 times per
 //!   command.
 //! * **Shared wire.** Host replies go out in the gap between servo transactions; a reply whose
