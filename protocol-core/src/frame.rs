@@ -9,6 +9,8 @@
 
 use heapless::Vec;
 
+use crate::scanner::{Format, Scan, Scanner};
+
 /// First two bytes of every host frame.
 pub const HEADER: u8 = 0xFE;
 /// Last byte of every host frame.
@@ -105,12 +107,7 @@ impl core::fmt::Debug for Frame {
 /// Memory: one buffer of [`MAX_FRAME_BYTES`] bytes. Never allocates, never panics.
 #[derive(Clone, Debug)]
 pub struct FrameDecoder {
-    buf: Vec<u8, MAX_FRAME_BYTES>,
-    /// How many bytes at the front of `buf` arrived before the last quiet gap: a candidate that
-    /// starts there can no longer complete.
-    stale: usize,
-    /// Bytes skipped because they were outside any frame or in a rejected candidate.
-    skipped: u32,
+    scanner: Scanner<MAX_FRAME_BYTES>,
 }
 
 impl Default for FrameDecoder {
@@ -119,34 +116,56 @@ impl Default for FrameDecoder {
     }
 }
 
-enum Scan {
-    /// The buffer holds the start of a candidate that needs more bytes.
-    NeedMore,
-    /// A complete frame of `n` bytes starts the buffer.
-    Complete(usize),
-    /// The first byte cannot start a frame; drop it.
-    Reject,
+/// The host-frame format for the [`Scanner`].
+struct HostFrames;
+
+impl Format for HostFrames {
+    const HEADER: u8 = HEADER;
+
+    fn scan(b: &[u8]) -> Scan {
+        match (b.first(), b.get(1), b.get(2)) {
+            (None, _, _) => Scan::NeedMore,
+            (Some(&h), _, _) if h != HEADER => Scan::Reject,
+            (_, None, _) => Scan::NeedMore,
+            (_, Some(&h), _) if h != HEADER => Scan::Reject,
+            (_, _, None) => Scan::NeedMore,
+            (_, _, Some(&len)) if !(MIN_LEN..=MAX_LEN).contains(&len) => Scan::Reject,
+            (_, _, Some(&len)) => match b.get(2 + len as usize) {
+                None => Scan::NeedMore,
+                Some(&FOOTER) => Scan::Complete(3 + len as usize),
+                Some(_) => Scan::Reject,
+            },
+        }
+    }
+
+    fn missing(b: &[u8]) -> usize {
+        match b {
+            [HEADER, HEADER, len, ..] if (MIN_LEN..=MAX_LEN).contains(len) => {
+                (3 + *len as usize).saturating_sub(b.len())
+            }
+            _ => 1,
+        }
+    }
+}
+
+/// The frame in `bytes`, a complete `FE FE LEN CMD DATA FA`.
+fn frame_from(bytes: &[u8]) -> Option<Frame> {
+    let (&cmd, rest) = bytes.get(3..)?.split_first()?;
+    let (_footer, data) = rest.split_last()?;
+    Frame::new(cmd, data)
 }
 
 impl FrameDecoder {
     /// An empty decoder.
     pub const fn new() -> Self {
         Self {
-            buf: Vec::new(),
-            stale: 0,
-            skipped: 0,
+            scanner: Scanner::new(),
         }
     }
 
     /// Appends one received byte; returns the frame it completes, if any.
     pub fn push(&mut self, byte: u8) -> Option<Frame> {
-        if self.buf.is_full() {
-            // Only reachable when a caller ignored frames waiting in `next_frame`: make room by
-            // dropping the oldest byte rather than failing.
-            self.drop_front(1);
-        }
-        // Cannot fail: there is room now.
-        let _ = self.buf.push(byte);
+        self.scanner.push(byte);
         self.next_frame()
     }
 
@@ -155,72 +174,14 @@ impl FrameDecoder {
     /// Same result as [`push`](Self::push)ing byte by byte and draining, but faster: while idle
     /// it skips straight to the next `FE`, and once a candidate's LEN is known it copies the
     /// rest of the candidate in one go.
-    pub fn feed(&mut self, mut bytes: &[u8], mut on_frame: impl FnMut(Frame)) {
-        while !bytes.is_empty() {
-            let take = if self.stale != 0 {
-                1
-            } else if self.buf.is_empty() {
-                // Idle: no byte before the next FE can start a frame.
-                let skip = bytes
-                    .iter()
-                    .position(|&b| b == HEADER)
-                    .unwrap_or(bytes.len());
-                // skip <= bytes.len(); a wrap of the statistics counter is harmless.
-                self.skipped = self.skipped.wrapping_add(skip as u32);
-                bytes = bytes.get(skip..).unwrap_or_default();
-                if bytes.is_empty() {
-                    return;
-                }
-                1
-            } else {
-                self.missing().clamp(1, bytes.len())
-            };
-            let (chunk, rest) = bytes.split_at(take.min(bytes.len()));
-            bytes = rest;
-            // `take` fits the buffer unless a caller left frames undrained: then evict.
-            if self.buf.extend_from_slice(chunk).is_err() {
-                for &b in chunk {
-                    if self.buf.is_full() {
-                        self.drop_front(1);
-                    }
-                    let _ = self.buf.push(b);
-                }
-            }
-            while let Some(frame) = self.next_frame() {
-                on_frame(frame);
-            }
-        }
-    }
-
-    /// Bytes still missing from the candidate at the front of the buffer, once its LEN is
-    /// known; 1 while the header is incomplete.
-    fn missing(&self) -> usize {
-        match self.buf.as_slice() {
-            [HEADER, HEADER, len, ..] if (MIN_LEN..=MAX_LEN).contains(len) => {
-                (3 + *len as usize).saturating_sub(self.buf.len())
-            }
-            _ => 1,
-        }
+    pub fn feed(&mut self, bytes: &[u8], on_frame: impl FnMut(Frame)) {
+        self.scanner
+            .feed::<HostFrames, _>(bytes, frame_from, on_frame);
     }
 
     /// Returns the next complete frame already in the buffer, if any.
     pub fn next_frame(&mut self) -> Option<Frame> {
-        loop {
-            match self.scan() {
-                Scan::NeedMore if self.stale == 0 => return None,
-                Scan::NeedMore | Scan::Reject => self.drop_front(1),
-                Scan::Complete(n) => {
-                    let frame = self
-                        .buf
-                        .get(4..n - 1)
-                        .and_then(|data| Frame::new(self.buf.get(3).copied().unwrap_or(0), data));
-                    self.drop_front(n);
-                    if frame.is_some() {
-                        return frame;
-                    }
-                }
-            }
-        }
+        self.scanner.next::<HostFrames, _>(frame_from)
     }
 
     /// Tells the decoder the line has been quiet long enough that a frame in progress was cut
@@ -228,52 +189,19 @@ impl FrameDecoder {
     /// complete frame found inside them on the rescan is returned (drain with
     /// [`next_frame`](Self::next_frame) as after [`push`](Self::push)).
     pub fn on_quiet_line(&mut self) -> Option<Frame> {
-        self.stale = self.buf.len();
+        self.scanner.on_quiet_line();
         self.next_frame()
     }
 
     /// True while the decoder holds the start of a frame that is not complete yet.
     pub fn has_partial(&self) -> bool {
-        !self.buf.is_empty()
+        self.scanner.has_partial()
     }
 
     /// Number of received bytes that were not part of any frame (noise, servo packets,
     /// rejected candidates). Wraps at `u32::MAX`.
     pub fn skipped_bytes(&self) -> u32 {
-        self.skipped
-    }
-
-    /// Decides what the start of the buffer is.
-    fn scan(&self) -> Scan {
-        let b = &self.buf;
-        match (b.first(), b.get(1), b.get(2)) {
-            (None, _, _) => Scan::NeedMore,
-            (Some(&h), _, _) if h != HEADER => Scan::Reject,
-            (_, None, _) => Scan::NeedMore,
-            (_, Some(&h), _) if h != HEADER => Scan::Reject,
-            (_, _, None) => Scan::NeedMore,
-            (_, _, Some(&len)) if !(MIN_LEN..=MAX_LEN).contains(&len) => Scan::Reject,
-            (_, _, Some(&len)) => {
-                let n = 3 + len as usize;
-                match b.get(n - 1) {
-                    None => Scan::NeedMore,
-                    Some(&FOOTER) => Scan::Complete(n),
-                    Some(_) => Scan::Reject,
-                }
-            }
-        }
-    }
-
-    /// Removes the first `n` bytes of the buffer, counting rejected ones as skipped.
-    fn drop_front(&mut self, n: usize) {
-        let n = n.min(self.buf.len());
-        self.stale = self.stale.saturating_sub(n);
-        if n == 1 {
-            self.skipped = self.skipped.wrapping_add(1);
-        }
-        let len = self.buf.len();
-        self.buf.copy_within(n..len, 0);
-        self.buf.truncate(len - n);
+        self.scanner.skipped()
     }
 }
 

@@ -16,6 +16,7 @@
 pub mod command;
 pub mod frame;
 pub mod port;
+mod scanner;
 pub mod servo;
 pub mod timing;
 pub mod units;

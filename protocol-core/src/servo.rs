@@ -14,6 +14,8 @@
 
 use heapless::Vec;
 
+use crate::scanner::{Format, Scan, Scanner};
+
 /// First two bytes of every servo packet.
 pub const HEADER: u8 = 0xFF;
 /// The broadcast id: every servo obeys, none replies.
@@ -476,136 +478,29 @@ impl SyncWriteBuilder {
 /// checksum or impossible LEN is dropped and the scan restarts at the byte after its first `FF`.
 /// Drain [`next_packet`](Self::next_packet) after every `Some`, as for
 /// [`FrameDecoder`](crate::FrameDecoder).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct PacketDecoder {
-    buf: Vec<u8, MAX_PACKET_BYTES>,
-    stale: usize,
-    checksum_errors: u32,
+    scanner: Scanner<MAX_PACKET_BYTES>,
 }
 
-enum Scan {
-    NeedMore,
-    Complete(usize),
-    Reject,
-    BadChecksum,
+impl Default for PacketDecoder {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
-impl PacketDecoder {
-    /// An empty decoder.
-    pub const fn new() -> Self {
-        Self {
-            buf: Vec::new(),
-            stale: 0,
-            checksum_errors: 0,
-        }
-    }
+/// The servo-packet format for the [`Scanner`].
+struct ServoPackets;
 
-    /// Appends one received byte; returns the packet it completes, if any.
-    pub fn push(&mut self, byte: u8) -> Option<Packet> {
-        if self.buf.is_full() {
-            self.drop_front(1);
-        }
-        let _ = self.buf.push(byte);
-        self.next_packet()
-    }
+/// Whether `len` is a possible LEN byte of a servo packet.
+fn valid_len(len: u8) -> bool {
+    (2..=MAX_PARAMS as u8 + 2).contains(&len)
+}
 
-    /// Feeds every byte of `bytes`, calling `on_packet` with each packet found, in order.
-    ///
-    /// Same result as [`push`](Self::push)ing byte by byte and draining, but faster: while idle
-    /// it skips straight to the next `FF`, and once a candidate's LEN is known it copies the
-    /// rest of the candidate in one go.
-    pub fn feed(&mut self, mut bytes: &[u8], mut on_packet: impl FnMut(Packet)) {
-        while !bytes.is_empty() {
-            let take = if self.stale != 0 {
-                1
-            } else if self.buf.is_empty() {
-                // Idle: no byte before the next FF can start a packet.
-                let skip = bytes
-                    .iter()
-                    .position(|&b| b == HEADER)
-                    .unwrap_or(bytes.len());
-                bytes = bytes.get(skip..).unwrap_or_default();
-                if bytes.is_empty() {
-                    return;
-                }
-                1
-            } else {
-                self.missing().clamp(1, bytes.len())
-            };
-            let (chunk, rest) = bytes.split_at(take.min(bytes.len()));
-            bytes = rest;
-            // `take` fits the buffer unless a caller left frames undrained: then evict.
-            if self.buf.extend_from_slice(chunk).is_err() {
-                for &b in chunk {
-                    if self.buf.is_full() {
-                        self.drop_front(1);
-                    }
-                    let _ = self.buf.push(b);
-                }
-            }
-            while let Some(packet) = self.next_packet() {
-                on_packet(packet);
-            }
-        }
-    }
+impl Format for ServoPackets {
+    const HEADER: u8 = HEADER;
 
-    /// Bytes still missing from the candidate at the front of the buffer, once its LEN is
-    /// known; 1 while the header is incomplete.
-    fn missing(&self) -> usize {
-        match self.buf.as_slice() {
-            [HEADER, HEADER, id, len, ..]
-                if *id != HEADER && (2..=MAX_PARAMS as u8 + 2).contains(len) =>
-            {
-                (4 + *len as usize).saturating_sub(self.buf.len())
-            }
-            _ => 1,
-        }
-    }
-
-    /// Returns the next complete packet already in the buffer, if any.
-    pub fn next_packet(&mut self) -> Option<Packet> {
-        loop {
-            match self.scan() {
-                Scan::NeedMore if self.stale == 0 => return None,
-                Scan::NeedMore | Scan::Reject => self.drop_front(1),
-                Scan::BadChecksum => {
-                    self.checksum_errors = self.checksum_errors.wrapping_add(1);
-                    self.drop_front(1);
-                }
-                Scan::Complete(n) => {
-                    let b = &self.buf;
-                    let packet = match (b.get(2), b.get(4), b.get(5..n - 1)) {
-                        (Some(&id), Some(&code), Some(params)) => Packet::new(id, code, params),
-                        _ => None,
-                    };
-                    self.drop_front(n);
-                    if packet.is_some() {
-                        return packet;
-                    }
-                }
-            }
-        }
-    }
-
-    /// Tells the decoder the wire went quiet: a packet still incomplete was cut short. Returns a
-    /// complete packet uncovered by the rescan, if any (drain as after [`push`](Self::push)).
-    pub fn on_quiet_line(&mut self) -> Option<Packet> {
-        self.stale = self.buf.len();
-        self.next_packet()
-    }
-
-    /// True while the decoder holds the start of a packet that is not complete yet.
-    pub fn has_partial(&self) -> bool {
-        !self.buf.is_empty()
-    }
-
-    /// Number of candidates dropped for a wrong checksum (corrupted replies). Wraps.
-    pub fn checksum_errors(&self) -> u32 {
-        self.checksum_errors
-    }
-
-    fn scan(&self) -> Scan {
-        let b = &self.buf;
+    fn scan(b: &[u8]) -> Scan {
         match (b.first(), b.get(1), b.get(2), b.get(3)) {
             (None, ..) => Scan::NeedMore,
             (Some(&h), ..) if h != HEADER => Scan::Reject,
@@ -615,10 +510,8 @@ impl PacketDecoder {
             // FF FF FF: the first FF was noise (0xFF is never an id).
             (_, _, Some(&id), _) if id == HEADER => Scan::Reject,
             (_, _, _, None) => Scan::NeedMore,
+            (_, _, _, Some(&len)) if !valid_len(len) => Scan::Reject,
             (_, _, Some(&id), Some(&len)) => {
-                if !(2..=MAX_PARAMS as u8 + 2).contains(&len) {
-                    return Scan::Reject;
-                }
                 let n = 4 + len as usize;
                 let (Some(&code), Some(params), Some(&chk)) =
                     (b.get(4), b.get(5..n - 1), b.get(n - 1))
@@ -634,12 +527,69 @@ impl PacketDecoder {
         }
     }
 
-    fn drop_front(&mut self, n: usize) {
-        let n = n.min(self.buf.len());
-        self.stale = self.stale.saturating_sub(n);
-        let len = self.buf.len();
-        self.buf.copy_within(n..len, 0);
-        self.buf.truncate(len - n);
+    fn missing(b: &[u8]) -> usize {
+        match b {
+            [HEADER, HEADER, id, len, ..] if *id != HEADER && valid_len(*len) => {
+                (4 + *len as usize).saturating_sub(b.len())
+            }
+            _ => 1,
+        }
+    }
+}
+
+/// The packet in `bytes`, a complete `FF FF ID LEN CODE PARAMS CHK` with a valid checksum.
+fn packet_from(bytes: &[u8]) -> Option<Packet> {
+    let [_, _, id, _, code, rest @ ..] = bytes else {
+        return None;
+    };
+    let (_checksum, params) = rest.split_last()?;
+    Packet::new(*id, *code, params)
+}
+
+impl PacketDecoder {
+    /// An empty decoder.
+    pub const fn new() -> Self {
+        Self {
+            scanner: Scanner::new(),
+        }
+    }
+
+    /// Appends one received byte; returns the packet it completes, if any.
+    pub fn push(&mut self, byte: u8) -> Option<Packet> {
+        self.scanner.push(byte);
+        self.next_packet()
+    }
+
+    /// Feeds every byte of `bytes`, calling `on_packet` with each packet found, in order.
+    ///
+    /// Same result as [`push`](Self::push)ing byte by byte and draining, but faster: while idle
+    /// it skips straight to the next `FF`, and once a candidate's LEN is known it copies the
+    /// rest of the candidate in one go.
+    pub fn feed(&mut self, bytes: &[u8], on_packet: impl FnMut(Packet)) {
+        self.scanner
+            .feed::<ServoPackets, _>(bytes, packet_from, on_packet);
+    }
+
+    /// Returns the next complete packet already in the buffer, if any.
+    pub fn next_packet(&mut self) -> Option<Packet> {
+        self.scanner.next::<ServoPackets, _>(packet_from)
+    }
+
+    /// Tells the decoder the wire went quiet: a packet still incomplete was cut short. Returns a
+    /// complete packet uncovered by the rescan, if any (drain as after [`push`](Self::push)).
+    pub fn on_quiet_line(&mut self) -> Option<Packet> {
+        self.scanner.on_quiet_line();
+        self.next_packet()
+    }
+
+    /// True while the decoder holds the start of a packet that is not complete yet.
+    pub fn has_partial(&self) -> bool {
+        self.scanner.has_partial()
+    }
+
+    /// Number of candidates dropped for a wrong checksum (corrupted replies). Wraps.
+    pub fn checksum_errors(&self) -> u32 {
+        self.scanner.bad_checksums()
     }
 }
 
