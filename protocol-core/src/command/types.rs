@@ -3,27 +3,37 @@
 
 use crate::units::{Centideg, DeciMm};
 
-/// An arm joint, 1..=6 (1 = base, 6 = flange rotation). The wire byte is the number itself.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct JointId(u8);
+/// Declares a one-byte newtype that can only hold the values matching `$allowed`: `new`
+/// checks, `get` gives the wire byte back.
+macro_rules! checked_byte {
+    ($(#[$meta:meta])* $name:ident($allowed:pat), $what:literal) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+        pub struct $name(u8);
+
+        impl $name {
+            #[doc = concat!("A ", $what, "; `None` for a value the protocol does not allow.")]
+            pub const fn new(v: u8) -> Option<Self> {
+                if matches!(v, $allowed) { Some(Self(v)) } else { None }
+            }
+
+            /// The wire byte.
+            pub const fn get(self) -> u8 {
+                self.0
+            }
+        }
+    };
+}
+
+checked_byte!(
+    /// An arm joint, 1..=6 (1 = base, 6 = flange rotation). The wire byte is the number itself.
+    JointId(1..=6),
+    "joint"
+);
 
 impl JointId {
     /// Number of arm joints.
     pub const COUNT: usize = 6;
-
-    /// A joint; `None` outside 1..=6.
-    pub const fn new(number: u8) -> Option<Self> {
-        if number >= 1 && number <= 6 {
-            Some(Self(number))
-        } else {
-            None
-        }
-    }
-
-    /// The joint number, 1..=6.
-    pub const fn get(self) -> u8 {
-        self.0
-    }
 
     /// Zero-based index into a six-joint array, 0..=5.
     pub const fn index(self) -> usize {
@@ -36,27 +46,15 @@ impl JointId {
     }
 }
 
-/// A servo on the bus, 1..=7: the six joints and the gripper servo (7).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct ServoId(u8);
+checked_byte!(
+    /// A servo on the bus, 1..=7: the six joints and the gripper servo (7); also its bus id.
+    ServoId(1..=7),
+    "servo"
+);
 
 impl ServoId {
     /// The gripper servo.
     pub const GRIPPER: Self = Self(7);
-
-    /// A servo; `None` outside 1..=7.
-    pub const fn new(id: u8) -> Option<Self> {
-        if id >= 1 && id <= 7 {
-            Some(Self(id))
-        } else {
-            None
-        }
-    }
-
-    /// The servo id, 1..=7 (also its id on the bus).
-    pub const fn get(self) -> u8 {
-        self.0
-    }
 
     /// The arm joint this servo drives, or `None` for the gripper.
     pub const fn joint(self) -> Option<JointId> {
@@ -416,18 +414,15 @@ impl AtomPin {
     }
 }
 
-/// An output of the Basic (0xA0): GPIO 2, or 5 (drives the suction-pump valve).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct BasicOutputPin(u8);
+checked_byte!(
+    /// An output of the Basic (0xA0): GPIO 2, or 5 (drives the suction-pump valve).
+    BasicOutputPin(2 | 5),
+    "Basic output pin"
+);
 
 impl BasicOutputPin {
-    /// GPIO numbers of the Basic's outputs.
+    /// GPIO numbers allowed.
     pub const ALLOWED: [u8; 2] = [2, 5];
-
-    /// A pin; `None` for other GPIOs.
-    pub fn new(gpio: u8) -> Option<Self> {
-        Self::ALLOWED.contains(&gpio).then_some(Self(gpio))
-    }
 
     /// The GPIO number.
     pub const fn gpio(self) -> u8 {
@@ -435,18 +430,15 @@ impl BasicOutputPin {
     }
 }
 
-/// An input of the Basic (0xA1): GPIO 35 or 36.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct BasicInputPin(u8);
+checked_byte!(
+    /// An input of the Basic (0xA1): GPIO 35 or 36.
+    BasicInputPin(35 | 36),
+    "Basic input pin"
+);
 
 impl BasicInputPin {
-    /// GPIO numbers of the Basic's inputs.
+    /// GPIO numbers allowed.
     pub const ALLOWED: [u8; 2] = [35, 36];
-
-    /// A pin; `None` for other GPIOs.
-    pub fn new(gpio: u8) -> Option<Self> {
-        Self::ALLOWED.contains(&gpio).then_some(Self(gpio))
-    }
 
     /// The GPIO number.
     pub const fn gpio(self) -> u8 {
@@ -477,68 +469,28 @@ impl GripperState {
     }
 }
 
-/// Gripper speed in percent, 0..=100 (pymycobot allows 0: `gripper_stop` sends it).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct GripperSpeed(u8);
+checked_byte!(
+    /// Gripper speed in percent, 0..=100 (pymycobot allows 0: `gripper_stop` sends it).
+    GripperSpeed(0..=100),
+    "gripper speed in percent"
+);
 
-impl GripperSpeed {
-    /// A speed; `None` above 100.
-    pub const fn new(percent: u8) -> Option<Self> {
-        if percent <= 100 {
-            Some(Self(percent))
-        } else {
-            None
-        }
-    }
+checked_byte!(
+    /// Gripper opening in percent, 0 (closed) ..= 100 (open).
+    GripperValue(0..=100),
+    "gripper opening in percent"
+);
 
-    /// The percentage, 0..=100.
-    pub const fn get(self) -> u8 {
-        self.0
-    }
-}
-
-/// Gripper opening in percent, 0 (closed) ..= 100 (open).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct GripperValue(u8);
-
-impl GripperValue {
-    /// An opening; `None` above 100.
-    pub const fn new(percent: u8) -> Option<Self> {
-        if percent <= 100 {
-            Some(Self(percent))
-        } else {
-            None
-        }
-    }
-
-    /// The percentage, 0..=100.
-    pub const fn get(self) -> u8 {
-        self.0
-    }
-}
-
-/// Gripper model byte of 0x65..0x67 (pymycobot): 1 adaptive, 2 five-finger hand, 3 parallel,
-/// 4 flexible, 5 (other vendor model).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct GripperType(u8);
+checked_byte!(
+    /// Gripper model byte of 0x65..0x67 (pymycobot): 1 adaptive, 2 five-finger hand, 3 parallel,
+    /// 4 flexible, 5 (other vendor model).
+    GripperType(1..=5),
+    "gripper model"
+);
 
 impl GripperType {
     /// The adaptive gripper, the default.
     pub const ADAPTIVE: Self = Self(1);
-
-    /// A model; `None` outside 1..=5.
-    pub const fn new(v: u8) -> Option<Self> {
-        if v >= 1 && v <= 5 {
-            Some(Self(v))
-        } else {
-            None
-        }
-    }
-
-    /// The wire byte, 1..=5.
-    pub const fn get(self) -> u8 {
-        self.0
-    }
 }
 
 /// The optional tail of 0x66/0x67: nothing, a gripper type, or a type and a torque flag.
