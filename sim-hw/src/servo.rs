@@ -653,6 +653,21 @@ mod tests {
     }
 
     impl Rig {
+        /// Time from the end of the controller's request to the start of the answer.
+        fn turnaround_ns(&self, trace: &[BusByte]) -> u64 {
+            let request_end = trace
+                .iter()
+                .rfind(|b| b.from == self.controller)
+                .unwrap()
+                .end_ns;
+            let answer_start = trace
+                .iter()
+                .find(|b| b.from != self.controller)
+                .unwrap()
+                .start_ns;
+            answer_start - request_end
+        }
+
         fn new(ids: &[u8]) -> Self {
             let mut bus = Bus::mycobot(3);
             bus.set_tracing(true);
@@ -746,17 +761,7 @@ mod tests {
     fn ping_is_answered_within_the_turnaround_budget() {
         let mut rig = Rig::new(&[1]);
         let trace = rig.exchange(&Instruction::Ping.to_packet(1).unwrap());
-        let request_end = trace
-            .iter()
-            .rfind(|b| b.from == rig.controller)
-            .unwrap()
-            .end_ns;
-        let answer_start = trace
-            .iter()
-            .find(|b| b.from != rig.controller)
-            .unwrap()
-            .start_ns;
-        let turnaround = answer_start - request_end;
+        let turnaround = rig.turnaround_ns(&trace);
         assert!(turnaround > 0 && turnaround <= SERVO_TURNAROUND_MAX_US * 1_000);
         let answers = rig.answers(&trace);
         assert_eq!(answers.len(), 1);
@@ -772,17 +777,7 @@ mod tests {
         rig.write(1, reg::EEPROM_LOCK, &[0]);
         rig.write(1, reg::RETURN_DELAY, &[50]);
         let trace = rig.exchange(&Instruction::Ping.to_packet(1).unwrap());
-        let request_end = trace
-            .iter()
-            .rfind(|b| b.from == rig.controller)
-            .unwrap()
-            .end_ns;
-        let answer_start = trace
-            .iter()
-            .find(|b| b.from != rig.controller)
-            .unwrap()
-            .start_ns;
-        assert_eq!(answer_start - request_end, 100_000 + PROCESSING_NS);
+        assert_eq!(rig.turnaround_ns(&trace), 100_000 + PROCESSING_NS);
     }
 
     #[test]
