@@ -25,7 +25,8 @@
 //!   into the [`JointLimits`], the best fit (exact, then up to 0.2 mm clamped, then traded at the
 //!   wrist singularity) nearest the seed; or an [`IkError`] (protocol error 32). The zero pose,
 //!   the stretched elbow and the wrist singularity (J6 keeps the seed's angle) all solve.
-//! * [`LinearPath`]: straight-line moves and Cartesian jogs, stopping with [`PathError`]
+//! * [`Path`]s ([`Line`], [`Ray`], [`Turn`]) walked by [`PathWalker`], and [`LinearPath`] (a line
+//!   in equal steps): straight-line moves and Cartesian jogs, stopping with [`PathError`]
 //!   (33 / 34) instead of a joint jump or an unreachable step.
 //! * [`Transform`]-level variants (`forward_transform`, `inverse_transform`) for callers that
 //!   chain small Cartesian steps and should not round to the wire's units in between.
@@ -62,7 +63,7 @@ pub mod transform;
 
 pub use geometry::ArmGeometry;
 pub use limits::JointLimits;
-pub use path::{LinearPath, PathError};
+pub use path::{Line, LinearPath, Path, PathError, PathWalker, Ray, Turn};
 pub use transform::{Rotation, Transform};
 
 use fixed::Angle;

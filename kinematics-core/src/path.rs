@@ -1,10 +1,13 @@
-//! Straight-line Cartesian motion (move mode 1, jog coord): the position moves along the line,
-//! the orientation turns about the one axis of the shortest rotation, and every step is solved
-//! with the previous step as seed, so the arm stays on one branch. Where a step would move a
-//! joint more than the per-step limit (next to a singularity joints speed up), the step is
-//! halved, down to 1/64: the path slows there instead of flailing. A step that has no solution,
-//! or that still jumps at 1/64 (a branch switch, e.g. through the wrist singularity), stops the
-//! path instead of being executed.
+//! Cartesian paths: where the end goes (a [`Path`]: a straight [`Line`], a [`Ray`] along a base
+//! axis, a [`Turn`] about one, and later arcs) and how joint angles follow it ([`PathWalker`]).
+//!
+//! A path is a pose for every point along it, measured in micrometres of travel, a degree of
+//! rotation counting as a millimetre ([`Path::length_um`]). The walker solves each point with the
+//! previous one as seed, so the arm stays on one branch. Where a step would move a joint more
+//! than the per-step limit (next to a singularity joints speed up), the step is halved, down to
+//! 1/64: the path slows there instead of flailing. A step that has no solution, or that still
+//! jumps at 1/64 (a branch switch, e.g. through the wrist singularity), stops the path instead of
+//! being executed. [`LinearPath`] is a line walked in equal steps.
 
 use crate::fixed::{Angle, ratio};
 use crate::transform::{LEN_PER_TENTH_MM, Rotation, Transform};
@@ -17,14 +20,18 @@ pub const DEFAULT_MAX_JOINT_STEP_CENTIDEG: i32 = 500;
 /// A step may be halved this many times (to 1/64) to keep joints within the per-step limit.
 const SPLIT_BITS: u32 = 6;
 
-/// Most steps in a path (2^20: 100 m at 0.1 mm per step), keeping the interpolation in `i64`.
-const MAX_STEPS: i64 = 1 << 20;
+/// Internal length units per micrometre of path.
+const LEN_PER_UM: i64 = LEN_PER_TENTH_MM / 100;
 
-/// Rotation allowed per step for each 0.1 mm of step length: 0.1 deg, i.e. a 1 mm step may turn
-/// 1 deg (the end moves about 1 mm per degree at the flange's 57 mm lever).
-const CENTIDEG_PER_TENTH_MM_STEP: i64 = 10;
+/// Path micrometres per centidegree of rotation: a degree of rotation counts as a millimetre of
+/// travel (the end moves about 1 mm per degree at the flange's 57 mm lever).
+const UM_PER_CENTIDEG: i64 = 10;
 
-/// Why a linear move stops (protocol 0x07 codes in [`PathError::protocol_code`]).
+/// Longest open-ended path ([`Ray`], [`Turn`]): 2 m or 2000 deg, far beyond the arm's reach, so
+/// a jog always ends at the workspace edge or a limit first.
+pub const OPEN_PATH_UM: i64 = 2_000_000;
+
+/// Why a path stops (protocol 0x07 codes in [`PathError::protocol_code`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PathError {
     /// The nearest solution of a step, even split to 1/64, moves a joint by more than the
@@ -47,23 +54,261 @@ impl PathError {
     }
 }
 
-/// A straight line from a start configuration to a target pose (in the model's selected tool and
-/// world frames), in equal steps (split near singularities); yields each step's joint angles,
-/// the last one solving the target itself.
-#[derive(Clone, Copy, Debug)]
-pub struct LinearPath {
+/// A Cartesian path of the end (in the model's selected tool and world frames).
+pub trait Path {
+    /// Length in micrometres of travel, a degree of rotation counting as a millimetre.
+    fn length_um(&self) -> i64;
+    /// The pose `at_um` along the path (0 = start; at or beyond the length, the end).
+    fn pose_at(&self, at_um: i64) -> Transform;
+}
+
+/// A straight line: the position moves along the segment, the orientation turns about the one
+/// axis of the shortest rotation, both in proportion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Line {
     start: Transform,
     target: Transform,
     /// Unit axis (Q30) and angle of the rotation from the start to the target orientation,
     /// expressed in the start frame.
     axis: [i64; 3],
     angle: Angle,
+    length_um: i64,
+}
+
+impl Line {
+    /// The line from the end pose at joint angles `start` to `target`. Fails with the target's
+    /// [`IkError`] (protocol error 32) if the target has no solution.
+    pub fn new(kin: &Kinematics, start: &JointAngles, target: &Pose) -> Result<Self, IkError> {
+        let target = Transform::from_pose(target);
+        kin.inverse_transform(&target, start)?;
+        Ok(Self::between(kin.forward_transform(start), target))
+    }
+
+    /// The line between two transforms (no reachability check).
+    pub fn between(start: Transform, target: Transform) -> Self {
+        let (axis, angle) = start
+            .rotation
+            .transpose()
+            .mul(&target.rotation)
+            .to_axis_angle();
+        let [dx, dy, dz] = [0, 1, 2].map(|i| {
+            target.position.get(i).copied().unwrap_or(0)
+                - start.position.get(i).copied().unwrap_or(0)
+        });
+        let distance_um = crate::fixed::sqrt(dx * dx + dy * dy + dz * dz) / LEN_PER_UM;
+        let rotation_um = i64::from(angle.to_centideg().abs()) * UM_PER_CENTIDEG;
+        Self {
+            start,
+            target,
+            axis,
+            angle,
+            length_um: distance_um.max(rotation_um),
+        }
+    }
+}
+
+impl Path for Line {
+    fn length_um(&self) -> i64 {
+        self.length_um
+    }
+
+    fn pose_at(&self, at_um: i64) -> Transform {
+        if at_um >= self.length_um {
+            return self.target;
+        }
+        let at = at_um.max(0);
+        let lerp = |i: usize| {
+            let a = self.start.position.get(i).copied().unwrap_or(0);
+            let b = self.target.position.get(i).copied().unwrap_or(0);
+            a + ratio((b - a) * at, self.length_um)
+        };
+        let turn = Angle(ratio(i64::from(self.angle.0) * at, self.length_um) as i32);
+        Transform {
+            rotation: self
+                .start
+                .rotation
+                .mul(&Rotation::about_axis(&self.axis, turn)),
+            position: [lerp(0), lerp(1), lerp(2)],
+        }
+    }
+}
+
+/// An open-ended straight line along a base axis (x, y or z of the reference frame), the
+/// orientation kept: a Cartesian jog (0x30, 0x32).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Ray {
+    start: Transform,
+    axis: usize,
+    sign: i64,
+}
+
+impl Ray {
+    /// From `start` along base axis `axis` (0 x, 1 y, 2 z), positive if `positive`.
+    pub fn new(start: Transform, axis: usize, positive: bool) -> Self {
+        Self {
+            start,
+            axis,
+            sign: if positive { 1 } else { -1 },
+        }
+    }
+}
+
+impl Path for Ray {
+    fn length_um(&self) -> i64 {
+        OPEN_PATH_UM
+    }
+
+    fn pose_at(&self, at_um: i64) -> Transform {
+        let mut pose = self.start;
+        if let Some(v) = pose.position.get_mut(self.axis) {
+            *v += self.sign * at_um.clamp(0, OPEN_PATH_UM) * LEN_PER_UM;
+        }
+        pose
+    }
+}
+
+/// An open-ended rotation about a base axis (x, y or z of the reference frame), the position
+/// kept: a rotation jog (0x31).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Turn {
+    start: Transform,
+    axis: [i64; 3],
+    sign: i64,
+}
+
+impl Turn {
+    /// From `start` about base axis `axis` (0 x, 1 y, 2 z), positive (right-handed) if
+    /// `positive`.
+    pub fn new(start: Transform, axis: usize, positive: bool) -> Self {
+        let mut unit = [0; 3];
+        if let Some(v) = unit.get_mut(axis) {
+            *v = crate::fixed::ONE;
+        }
+        Self {
+            start,
+            axis: unit,
+            sign: if positive { 1 } else { -1 },
+        }
+    }
+}
+
+impl Path for Turn {
+    fn length_um(&self) -> i64 {
+        OPEN_PATH_UM
+    }
+
+    fn pose_at(&self, at_um: i64) -> Transform {
+        // One micrometre is a millidegree: 2^32 / 360 000 angle units.
+        let millideg = self.sign * at_um.clamp(0, OPEN_PATH_UM);
+        let turn = Angle(ratio(millideg << 32, 360_000) as i32);
+        Transform {
+            rotation: Rotation::about_axis(&self.axis, turn).mul(&self.start.rotation),
+            position: self.start.position,
+        }
+    }
+}
+
+/// Joint angles following a [`Path`]: each advance solves the next point with the previous one
+/// as seed, halving the advance (down to 1/64) while a joint would move more than the limit.
+#[derive(Clone, Copy, Debug)]
+pub struct PathWalker<P> {
+    path: P,
     previous: JointAngles,
-    /// Progress and length of the line in 1/64 steps.
-    done: i64,
-    total: i64,
-    max_joint_step_centideg: i32,
+    done_um: i64,
     stopped: bool,
+}
+
+impl<P: Path> PathWalker<P> {
+    /// A walker at the start of `path`, the arm at joint angles `start` (which should put the
+    /// end at the path's start).
+    pub fn new(path: P, start: JointAngles) -> Self {
+        Self {
+            path,
+            previous: start,
+            done_um: 0,
+            stopped: false,
+        }
+    }
+
+    /// Moves up to `advance_um` along the path, no joint more than `max_joint_step_centideg`
+    /// from the previous point: returns the new joint angles and how far it got (less than asked
+    /// where joints would move too fast); `None` at the end of the path or after an error
+    /// (which ends the path).
+    pub fn advance(
+        &mut self,
+        kin: &Kinematics,
+        advance_um: i64,
+        max_joint_step_centideg: i32,
+    ) -> Option<Result<(JointAngles, i64), PathError>> {
+        let length = self.path.length_um();
+        if self.stopped || self.done_um >= length {
+            return None;
+        }
+        let mut size = advance_um.clamp(1, length - self.done_um);
+        let mut splits = 0;
+        let result = loop {
+            let at = self.done_um + size;
+            let q = match kin.inverse_transform(&self.path.pose_at(at), &self.previous) {
+                Ok(q) => q,
+                Err(e) => break Err(PathError::StepUnreachable(e)),
+            };
+            match self.jumping_joint(&q, max_joint_step_centideg) {
+                None => {
+                    let taken = at - self.done_um;
+                    self.done_um = at;
+                    self.previous = q;
+                    break Ok((q, taken));
+                }
+                Some(_) if splits < SPLIT_BITS && size > 1 => {
+                    size = (size / 2).max(1);
+                    splits += 1;
+                }
+                Some(joint) => break Err(PathError::BranchJump { joint }),
+            }
+        };
+        self.stopped = result.is_err();
+        Some(result)
+    }
+
+    /// The first joint that moves more than `limit` from the previous point.
+    fn jumping_joint(&self, q: &JointAngles, limit: i32) -> Option<usize> {
+        q.0.iter()
+            .zip(self.previous.0.iter())
+            .position(|(a, b)| (i64::from(*a) - i64::from(*b)).abs() > i64::from(limit))
+    }
+
+    /// How far along the path the walker is, micrometres.
+    pub fn done_um(&self) -> i64 {
+        self.done_um
+    }
+
+    /// What is left of the path, micrometres (0 once done or stopped).
+    pub fn remaining_um(&self) -> i64 {
+        if self.stopped {
+            0
+        } else {
+            (self.path.length_um() - self.done_um).max(0)
+        }
+    }
+
+    /// The joint angles of the last point reached (the start before the first advance).
+    pub fn current(&self) -> JointAngles {
+        self.previous
+    }
+
+    /// The path being walked.
+    pub fn path(&self) -> &P {
+        &self.path
+    }
+}
+
+/// A straight line from a start configuration to a target pose in equal steps (split near
+/// singularities); yields each step's joint angles, the last one solving the target itself.
+#[derive(Clone, Copy, Debug)]
+pub struct LinearPath {
+    walker: PathWalker<Line>,
+    step_um: i64,
+    max_joint_step_centideg: i32,
 }
 
 impl LinearPath {
@@ -76,36 +321,13 @@ impl LinearPath {
         target: &Pose,
         step_tenth_mm: i32,
     ) -> Result<Self, IkError> {
-        let target = Transform::from_pose(target);
-        kin.inverse_transform(&target, start)?;
-        let from = kin.forward_transform(start);
-        let (axis, angle) = from
-            .rotation
-            .transpose()
-            .mul(&target.rotation)
-            .to_axis_angle();
-        let step_tenth_mm = i64::from(step_tenth_mm.max(1));
-        let [dx, dy, dz] = [0, 1, 2].map(|i| {
-            target.position.get(i).copied().unwrap_or(0)
-                - from.position.get(i).copied().unwrap_or(0)
-        });
-        let distance_tenth_mm = crate::fixed::sqrt(dx * dx + dy * dy + dz * dz) / LEN_PER_TENTH_MM;
-        let by_distance = div_ceil(distance_tenth_mm, step_tenth_mm);
-        let by_rotation = div_ceil(
-            i64::from(angle.to_centideg().abs()),
-            step_tenth_mm * CENTIDEG_PER_TENTH_MM_STEP,
-        );
-        let steps = by_distance.max(by_rotation).clamp(1, MAX_STEPS);
+        let line = Line::new(kin, start, target)?;
+        let most_um = i64::from(step_tenth_mm.max(1)) * 100;
+        let steps = div_ceil(line.length_um(), most_um).max(1);
         Ok(Self {
-            start: from,
-            target,
-            axis,
-            angle,
-            previous: *start,
-            done: 0,
-            total: steps << SPLIT_BITS,
+            step_um: div_ceil(line.length_um(), steps).max(1),
+            walker: PathWalker::new(line, *start),
             max_joint_step_centideg: DEFAULT_MAX_JOINT_STEP_CENTIDEG,
-            stopped: false,
         })
     }
 
@@ -116,78 +338,29 @@ impl LinearPath {
         self
     }
 
-    /// The pose (full precision) at `at` 1/64 steps along the line.
-    fn waypoint(&self, at: i64) -> Transform {
-        if at >= self.total {
-            return self.target;
-        }
-        let lerp = |i: usize| {
-            let a = self.start.position.get(i).copied().unwrap_or(0);
-            let b = self.target.position.get(i).copied().unwrap_or(0);
-            a + ratio((b - a) * at, self.total)
-        };
-        let turn = Angle(ratio(i64::from(self.angle.0) * at, self.total) as i32);
-        Transform {
-            rotation: self
-                .start
-                .rotation
-                .mul(&Rotation::about_axis(&self.axis, turn)),
-            position: [lerp(0), lerp(1), lerp(2)],
-        }
-    }
-
     /// Solves and returns the next step's joint angles (a whole step, or the largest part of one
     /// that keeps every joint within the per-step limit); `None` once the target was reached or
     /// after an error (which ends the path).
     pub fn next(&mut self, kin: &Kinematics) -> Option<Result<JointAngles, PathError>> {
-        if self.stopped || self.done >= self.total {
-            return None;
-        }
-        let mut size = 1 << SPLIT_BITS;
-        let result = loop {
-            let at = (self.done + size).min(self.total);
-            let q = match kin.inverse_transform(&self.waypoint(at), &self.previous) {
-                Ok(q) => q,
-                Err(e) => break Err(PathError::StepUnreachable(e)),
-            };
-            match self.jumping_joint(&q) {
-                None => {
-                    self.done = at;
-                    self.previous = q;
-                    break Ok(q);
-                }
-                Some(_) if size > 1 => size /= 2,
-                Some(joint) => break Err(PathError::BranchJump { joint }),
-            }
-        };
-        self.stopped = result.is_err();
-        Some(result)
-    }
-
-    /// The first joint that moves more than the per-step limit from the previous step.
-    fn jumping_joint(&self, q: &JointAngles) -> Option<usize> {
-        q.0.iter().zip(self.previous.0.iter()).position(|(a, b)| {
-            (i64::from(*a) - i64::from(*b)).abs() > i64::from(self.max_joint_step_centideg)
-        })
+        self.walker
+            .advance(kin, self.step_um, self.max_joint_step_centideg)
+            .map(|r| r.map(|(q, _)| q))
     }
 
     /// Whole steps in the path (more calls of [`LinearPath::next`] where steps get split).
     pub fn total_steps(&self) -> u32 {
-        u32::try_from(self.total >> SPLIT_BITS).unwrap_or(u32::MAX)
+        let steps = div_ceil(self.walker.path().length_um(), self.step_um).max(1);
+        u32::try_from(steps).unwrap_or(u32::MAX)
     }
 
     /// Whole steps not yet taken, rounded up (0 once done or stopped).
     pub fn remaining_steps(&self) -> u32 {
-        if self.stopped {
-            return 0;
-        }
-        let left = div_ceil(self.total - self.done, 1 << SPLIT_BITS);
-        u32::try_from(left).unwrap_or(u32::MAX)
+        u32::try_from(div_ceil(self.walker.remaining_um(), self.step_um)).unwrap_or(u32::MAX)
     }
 
     /// The joint angles of the last step taken (the start before the first step).
     pub fn current(&self) -> JointAngles {
-        self.previous
+        self.walker.current()
     }
 }
 
@@ -393,6 +566,53 @@ mod tests {
             Some(Err(PathError::BranchJump { .. }))
         ));
         assert_eq!(path.current(), start());
+    }
+
+    #[test]
+    fn a_ray_moves_along_its_axis_and_a_turn_keeps_the_position() {
+        let kin = Kinematics::new();
+        let from = kin.forward_transform(&start());
+        let ray = Ray::new(from, 2, false);
+        let mut walker = PathWalker::new(ray, start());
+        let mut went_um = 0;
+        for _ in 0..10 {
+            let (q, taken) = walker.advance(&kin, 1_000, 300).unwrap().unwrap();
+            went_um += taken;
+            let p = kin.forward(&q);
+            let f = from.to_pose();
+            assert_eq!((p.x, p.y), (f.x, f.y), "{p:?}");
+            assert!((i64::from(f.z - p.z) - went_um / 100).abs() <= 1, "{p:?}");
+            assert!(angle_between(&kin.forward_transform(&q).rotation, &from.rotation) <= 2);
+        }
+        assert_eq!(walker.done_um(), 10_000);
+
+        let turn = Turn::new(from, 2, true);
+        let mut walker = PathWalker::new(turn, start());
+        let (q, taken) = walker.advance(&kin, 5_000, 1_000).unwrap().unwrap();
+        assert_eq!(taken, 5_000);
+        let t = kin.forward_transform(&q);
+        let (p, f) = (t.to_pose(), from.to_pose());
+        assert!((p.x - f.x).abs() <= 1 && (p.y - f.y).abs() <= 1 && (p.z - f.z).abs() <= 1);
+        // 5 mm of path is 5 deg about the base z axis.
+        assert!((angle_between(&t.rotation, &from.rotation) - 500).abs() <= 2);
+    }
+
+    #[test]
+    fn a_walker_takes_less_than_asked_where_joints_would_move_too_far() {
+        let kin = Kinematics::new();
+        let zero = JointAngles::default();
+        let from = kin.forward(&zero);
+        let to = Pose {
+            z: from.z - 500,
+            ..from
+        };
+        let line = Line::new(&kin, &zero, &to).unwrap();
+        // 412.67 mm down to 362.7 mm.
+        assert_eq!(line.length_um(), 49_970);
+        let mut walker = PathWalker::new(line, zero);
+        let (_, taken) = walker.advance(&kin, 2_000, 500).unwrap().unwrap();
+        assert!(taken < 2_000, "{taken}");
+        assert_eq!(walker.remaining_um(), 49_970 - taken);
     }
 
     #[test]
