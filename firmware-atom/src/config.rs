@@ -60,7 +60,7 @@ pub const DEFAULT_LIMITS: [JointLimit; JOINTS] = [
 ];
 
 /// Speeds and accelerations at 100 % (`kinematics.md`: joints up to 150 deg/s and 200 deg/s^2,
-/// Cartesian up to 100 mm/s).
+/// Cartesian up to 100 mm/s), and what the servos can do.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MotionLimits {
     /// Fastest joint speed, centidegrees per second.
@@ -71,6 +71,14 @@ pub struct MotionLimits {
     pub linear_speed_decimm_per_s: u32,
     /// Fastest rotation speed of jog rpy and linear moves, centidegrees per second.
     pub rotation_speed_centideg_per_s: u32,
+    /// Acceleration of the end along a Cartesian path (lines, Cartesian jogs), tenth-millimetres
+    /// per second squared: how fast a path speeds up and slows down at its ends.
+    pub linear_accel_decimm_per_s2: u32,
+    /// The fastest a joint servo can speed up or brake, steps per second squared: what stopping
+    /// and following a stream assume. 11 400 (1 000 deg/s^2, acceleration register 114): below
+    /// what measured STS3215 models reach with the myCobot's position gains (`docs/motion.md`),
+    /// so a braking joint never overshoots the point it is told to stop at.
+    pub servo_accel_steps_per_s2: u32,
 }
 
 impl Default for MotionLimits {
@@ -80,6 +88,8 @@ impl Default for MotionLimits {
             joint_accel_centideg_per_s2: 20_000,
             linear_speed_decimm_per_s: 1_000,
             rotation_speed_centideg_per_s: 9_000,
+            linear_accel_decimm_per_s2: 5_000,
+            servo_accel_steps_per_s2: 11_400,
         }
     }
 }
@@ -150,7 +160,8 @@ pub enum ConfigError {
     BadJointLimit,
     /// The gripper range is empty or outside 0..4095.
     BadGripperRange,
-    /// A speed, acceleration or period is zero.
+    /// A speed, acceleration or period is zero, or the servo acceleration is outside what the
+    /// acceleration register can express (100..=25 400 steps/s^2).
     BadTiming,
 }
 
@@ -214,12 +225,45 @@ impl AtomConfig {
             || m.joint_accel_centideg_per_s2 == 0
             || m.linear_speed_decimm_per_s == 0
             || m.rotation_speed_centideg_per_s == 0
+            || m.linear_accel_decimm_per_s2 == 0
+            || !(100..=25_400).contains(&m.servo_accel_steps_per_s2)
             || t.interpolation_period_us == 0
             || t.misses_before_lost == 0
         {
             return Err(ConfigError::BadTiming);
         }
         Ok(())
+    }
+
+    /// The fastest joint speed at `speed_percent`, steps per second (at least 1).
+    pub fn joint_speed_steps(&self, speed_percent: u8) -> u32 {
+        let pct = u32::from(speed_percent.clamp(1, 100));
+        (centideg_to_steps(self.motion.joint_speed_centideg_per_s) * pct / 100).max(1)
+    }
+
+    /// The acceleration register value of the fastest joint in a planned joint move (100
+    /// steps/s^2 units, 1..=254).
+    pub fn joint_accel_register(&self) -> u8 {
+        (centideg_to_steps(self.motion.joint_accel_centideg_per_s2) / 100).clamp(1, 254) as u8
+    }
+
+    /// The acceleration register (100 steps/s^2 units) of the servos' full acceleration
+    /// ([`MotionLimits::servo_accel_steps_per_s2`]).
+    pub fn servo_accel_register(&self) -> u8 {
+        self.motion
+            .servo_accel_steps_per_s2
+            .div_ceil(100)
+            .clamp(1, 254) as u8
+    }
+
+    /// Encoder position of joint `joint` at `centideg`, in thousandths of a step (unrounded,
+    /// not limited to one turn).
+    pub fn angle_to_millisteps(&self, joint: usize, centideg: i32) -> i64 {
+        let a = match self.joint_signs.get(joint) {
+            Some(JointSign::Negative) => -i64::from(centideg),
+            _ => i64::from(centideg),
+        };
+        i64::from(STEPS_ZERO) * 1000 + a * i64::from(STEPS_PER_TURN) * 1000 / 36_000
     }
 
     /// Joint angle of encoder position `steps` of joint `joint` (0-based).
@@ -243,6 +287,11 @@ impl AtomConfig {
         let delta = (a * STEPS_PER_TURN + a.signum() * 18_000) / 36_000;
         Steps((STEPS_ZERO + delta).clamp(0, STEPS_PER_TURN - 1) as i16)
     }
+}
+
+/// Steps (per second, per second squared) of an angle (speed, acceleration) in centidegrees.
+pub fn centideg_to_steps(centideg: u32) -> u32 {
+    (u64::from(centideg) * STEPS_PER_TURN as u64 / 36_000) as u32
 }
 
 #[cfg(test)]

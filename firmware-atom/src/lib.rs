@@ -50,17 +50,25 @@
 #![forbid(unsafe_code)]
 
 mod atom;
+mod bank;
 pub mod bus;
 pub mod cartesian;
 mod commands;
 pub mod config;
 pub mod driver;
+pub mod error;
+mod gripper;
 pub mod health;
 pub mod io;
+mod link;
 pub mod motion;
+mod registers;
 pub mod safety;
+mod schedule;
+mod settings;
 
 pub use atom::Atom;
 pub use config::{AtomConfig, ConfigError, JointLimit, JointSign, TimingBudget};
+pub use error::AtomError;
 pub use health::ServoHealth;
 pub use io::{AtomIo, PinMode, RecordingIo};

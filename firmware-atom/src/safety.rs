@@ -2,13 +2,15 @@
 //! state.
 //!
 //! [`SafeGoals`] can only be made by [`check`], and the Atom sends position goals to servos
-//! only from a `SafeGoals` (`Atom::send_goals`): no command path (move, jog, linear
-//! interpolation, encoder write, raw servo data write) can put an unchecked goal on the bus.
+//! only from a `SafeGoals` (the servo bank's `send_goals`, its only maker of goals): no command
+//! path (move, jog, stream, path, braking, encoder write, raw servo data write) can put an
+//! unchecked goal on the bus.
 
 use protocol_core::servo::{SyncWriteBuilder, reg, to_sign_magnitude};
 use protocol_core::units::{Centideg, Steps};
 
 use crate::config::{AtomConfig, GRIPPER, JOINTS, JointLimit, SERVOS, STEPS_PER_TURN};
+use crate::error::AtomError;
 
 /// A goal for one servo: where to go and how (the STS move block).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,17 +36,6 @@ impl Goal {
 
 /// Goals per servo (index 0..5 joints, 6 gripper), `None` = leave that servo alone.
 pub type GoalSet = [Option<Goal>; SERVOS];
-
-/// Why a set of goals was refused.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Refusal {
-    /// The arm is powered off.
-    PoweredOff,
-    /// Joint `index` (0-based) would leave its limits.
-    JointLimit(usize),
-    /// The gripper goal is not an encoder position (0..4095).
-    GripperRange,
-}
 
 /// Goals that passed [`check`]. The only input of the goal-sending path.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -87,15 +78,15 @@ pub fn check(
     limits: &[JointLimit; JOINTS],
     powered: bool,
     goals: GoalSet,
-) -> Result<SafeGoals, Refusal> {
+) -> Result<SafeGoals, AtomError> {
     if !powered {
-        return Err(Refusal::PoweredOff);
+        return Err(AtomError::PoweredOff);
     }
     for (j, (goal, limit)) in goals.iter().zip(limits).enumerate() {
         if let Some(g) = goal
             && !goal_within(config, j, g.position, limit)
         {
-            return Err(Refusal::JointLimit(j));
+            return Err(AtomError::JointLimit(j));
         }
     }
     // The gripper has no angle limits: its goals only have to be encoder positions (clients
@@ -103,7 +94,7 @@ pub fn check(
     if let Some(Some(g)) = goals.get(GRIPPER)
         && !(0..STEPS_PER_TURN as i16).contains(&g.position.0)
     {
-        return Err(Refusal::GripperRange);
+        return Err(AtomError::GripperRange);
     }
     Ok(SafeGoals(goals))
 }
@@ -140,11 +131,14 @@ mod tests {
         goals[1] = Some(goal_at(&cfg, 1, 14_500)); // J2 limit is 140 deg
         assert_eq!(
             check(&cfg, &limits, true, goals),
-            Err(Refusal::JointLimit(1))
+            Err(AtomError::JointLimit(1))
         );
         goals[1] = Some(goal_at(&cfg, 1, 13_900));
         assert!(check(&cfg, &limits, true, goals).is_ok());
-        assert_eq!(check(&cfg, &limits, false, goals), Err(Refusal::PoweredOff));
+        assert_eq!(
+            check(&cfg, &limits, false, goals),
+            Err(AtomError::PoweredOff)
+        );
     }
 
     #[test]
@@ -158,7 +152,7 @@ mod tests {
         });
         assert_eq!(
             check(&cfg, &cfg.joint_limits, true, goals),
-            Err(Refusal::GripperRange)
+            Err(AtomError::GripperRange)
         );
     }
 

@@ -230,15 +230,17 @@ impl<P: Path> PathWalker<P> {
         }
     }
 
-    /// Moves up to `advance_um` along the path, no joint more than `max_joint_step_centideg`
-    /// from the previous point: returns the new joint angles and how far it got (less than asked
-    /// where joints would move too fast); `None` at the end of the path or after an error
-    /// (which ends the path).
+    /// Moves up to `advance_um` along the path: returns the new joint angles and how far it got;
+    /// `None` at the end of the path or after an error (which ends the path). While a joint
+    /// would move more than `slow_step_centideg` from the previous point the advance is halved
+    /// (down to 1/64), so the path slows where joints would have to hurry; a point that still
+    /// moves a joint more than `jump_step_centideg` is a branch jump ([`PathError::BranchJump`]).
     pub fn advance(
         &mut self,
         kin: &Kinematics,
         advance_um: i64,
-        max_joint_step_centideg: i32,
+        slow_step_centideg: i32,
+        jump_step_centideg: i32,
     ) -> Option<Result<(JointAngles, i64), PathError>> {
         let length = self.path.length_um();
         if self.stopped || self.done_um >= length {
@@ -252,29 +254,31 @@ impl<P: Path> PathWalker<P> {
                 Ok(q) => q,
                 Err(e) => break Err(PathError::StepUnreachable(e)),
             };
-            match self.jumping_joint(&q, max_joint_step_centideg) {
-                None => {
-                    let taken = at - self.done_um;
-                    self.done_um = at;
-                    self.previous = q;
-                    break Ok((q, taken));
-                }
-                Some(_) if splits < SPLIT_BITS && size > 1 => {
-                    size = (size / 2).max(1);
-                    splits += 1;
-                }
-                Some(joint) => break Err(PathError::BranchJump { joint }),
+            let (joint, step) = self.largest_step(&q);
+            if step > i64::from(slow_step_centideg) && splits < SPLIT_BITS && size > 1 {
+                size = (size / 2).max(1);
+                splits += 1;
+            } else if step > i64::from(jump_step_centideg) {
+                break Err(PathError::BranchJump { joint });
+            } else {
+                let taken = at - self.done_um;
+                self.done_um = at;
+                self.previous = q;
+                break Ok((q, taken));
             }
         };
         self.stopped = result.is_err();
         Some(result)
     }
 
-    /// The first joint that moves more than `limit` from the previous point.
-    fn jumping_joint(&self, q: &JointAngles, limit: i32) -> Option<usize> {
+    /// The joint that moves most from the previous point, and by how much (centidegrees).
+    fn largest_step(&self, q: &JointAngles) -> (usize, i64) {
         q.0.iter()
             .zip(self.previous.0.iter())
-            .position(|(a, b)| (i64::from(*a) - i64::from(*b)).abs() > i64::from(limit))
+            .map(|(a, b)| (i64::from(*a) - i64::from(*b)).abs())
+            .enumerate()
+            .max_by_key(|&(_, step)| step)
+            .unwrap_or((0, 0))
     }
 
     /// How far along the path the walker is, micrometres.
@@ -342,8 +346,9 @@ impl LinearPath {
     /// that keeps every joint within the per-step limit); `None` once the target was reached or
     /// after an error (which ends the path).
     pub fn next(&mut self, kin: &Kinematics) -> Option<Result<JointAngles, PathError>> {
+        let limit = self.max_joint_step_centideg;
         self.walker
-            .advance(kin, self.step_um, self.max_joint_step_centideg)
+            .advance(kin, self.step_um, limit, limit)
             .map(|r| r.map(|(q, _)| q))
     }
 
@@ -576,7 +581,7 @@ mod tests {
         let mut walker = PathWalker::new(ray, start());
         let mut went_um = 0;
         for _ in 0..10 {
-            let (q, taken) = walker.advance(&kin, 1_000, 300).unwrap().unwrap();
+            let (q, taken) = walker.advance(&kin, 1_000, 300, 500).unwrap().unwrap();
             went_um += taken;
             let p = kin.forward(&q);
             let f = from.to_pose();
@@ -588,7 +593,7 @@ mod tests {
 
         let turn = Turn::new(from, 2, true);
         let mut walker = PathWalker::new(turn, start());
-        let (q, taken) = walker.advance(&kin, 5_000, 1_000).unwrap().unwrap();
+        let (q, taken) = walker.advance(&kin, 5_000, 1_000, 1_000).unwrap().unwrap();
         assert_eq!(taken, 5_000);
         let t = kin.forward_transform(&q);
         let (p, f) = (t.to_pose(), from.to_pose());
@@ -610,7 +615,7 @@ mod tests {
         // 412.67 mm down to 362.7 mm.
         assert_eq!(line.length_um(), 49_970);
         let mut walker = PathWalker::new(line, zero);
-        let (_, taken) = walker.advance(&kin, 2_000, 500).unwrap().unwrap();
+        let (_, taken) = walker.advance(&kin, 2_000, 500, 500).unwrap().unwrap();
         assert!(taken < 2_000, "{taken}");
         assert_eq!(walker.remaining_um(), 49_970 - taken);
     }

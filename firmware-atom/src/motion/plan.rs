@@ -1,9 +1,9 @@
-//! Motion planning: how fast each servo must go so that a joint-interpolated move arrives
-//! everywhere at once, and what the robot is currently doing.
+//! Planned joint moves: how fast each servo must go so that a joint-interpolated move arrives
+//! everywhere at once (the servos' own ramps carry it out).
 
 use protocol_core::units::{Centideg, Steps};
 
-use crate::config::{AtomConfig, JOINTS, STEPS_PER_TURN};
+use crate::config::{AtomConfig, JOINTS};
 use crate::safety::{Goal, GoalSet};
 
 /// Joint-angle tolerance of "is in position" and of the end of a move: one degree, a little
@@ -13,22 +13,6 @@ pub const IN_POSITION_CENTIDEG: i32 = 100;
 /// A move waits at most this long beyond its planned duration before it is declared done
 /// (a stalled or missing servo must not block the queue forever).
 pub const MOVE_OVERTIME_US: u64 = 2_000_000;
-
-/// Steps per second of a joint speed in centidegrees per second.
-pub fn centideg_to_steps(centideg: u32) -> u32 {
-    (u64::from(centideg) * STEPS_PER_TURN as u64 / 36_000) as u32
-}
-
-/// The fastest joint speed at `speed_percent`, steps per second (at least 1).
-pub fn joint_speed_steps(config: &AtomConfig, speed_percent: u8) -> u32 {
-    let pct = u32::from(speed_percent.clamp(1, 100));
-    (centideg_to_steps(config.motion.joint_speed_centideg_per_s) * pct / 100).max(1)
-}
-
-/// The acceleration register value of the fastest joint (100 steps/s^2 units, 1..=254).
-pub fn joint_accel_register(config: &AtomConfig) -> u8 {
-    (centideg_to_steps(config.motion.joint_accel_centideg_per_s2) / 100).clamp(1, 254) as u8
-}
 
 /// A joint-interpolated move from `present` to `target`: every joint's speed and acceleration
 /// are scaled by its share of the longest travel, so that all joints start and arrive together.
@@ -46,8 +30,8 @@ pub fn plan_joint_move(
         }
     };
     let longest = (0..JOINTS).map(travel).max().unwrap_or(0).max(1);
-    let v_max = joint_speed_steps(config, speed_percent);
-    let a_max = u32::from(joint_accel_register(config));
+    let v_max = config.joint_speed_steps(speed_percent);
+    let a_max = u32::from(config.joint_accel_register());
     let mut goals: GoalSet = [None; crate::config::SERVOS];
     for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
         if let Some(position) = target.get(j).copied().flatten() {
@@ -74,44 +58,6 @@ pub fn angles_match(present: &[Centideg; JOINTS], target: &[Centideg; JOINTS]) -
         .all(|(p, t)| (i32::from(p.0) - i32::from(t.0)).abs() <= IN_POSITION_CENTIDEG)
 }
 
-/// A continuous jog direction.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum JogDirection {
-    /// Toward smaller values.
-    Negative,
-    /// Toward larger values.
-    Positive,
-}
-
-impl JogDirection {
-    /// +1 or -1.
-    pub fn sign(self) -> i32 {
-        match self {
-            Self::Negative => -1,
-            Self::Positive => 1,
-        }
-    }
-}
-
-/// What the arm is doing.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Activity {
-    /// Holding still.
-    Idle,
-    /// A joint-interpolated move toward `target`, planned to take `duration_us` from
-    /// `started_us`.
-    Moving {
-        /// Joint targets.
-        target: [Centideg; JOINTS],
-        /// When the goals were sent.
-        started_us: u64,
-        /// Planned duration.
-        duration_us: u64,
-        /// A continuous jog, stopped by the watchdog when the host goes silent.
-        jog: bool,
-    },
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -130,7 +76,7 @@ mod tests {
         ];
         let (goals, duration) = plan_joint_move(&cfg, &present, &target, 100);
         let speed = |j: usize| u32::from(goals[j].unwrap().speed_steps_per_s);
-        let v_max = joint_speed_steps(&cfg, 100);
+        let v_max = cfg.joint_speed_steps(100);
         assert_eq!(speed(0), v_max);
         assert_eq!(speed(1), v_max / 2);
         assert_eq!(speed(4), v_max / 4);

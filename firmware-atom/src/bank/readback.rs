@@ -3,11 +3,12 @@
 use protocol_core::servo::{Packet, reg, sign_magnitude};
 use protocol_core::units::Steps;
 
-use super::{Atom, Then};
+use super::{ServoBank, Then};
 use crate::config::SERVOS;
 use crate::driver::Op;
 use crate::health::ServoHealth;
 use crate::safety::{self, GoalSet};
+use crate::settings::Settings;
 
 /// First register of the state read: torque enable (40) through present current (69..70), so
 /// one READ per servo confirms torque and goal as well as the present state. 31 bytes: a
@@ -42,20 +43,20 @@ pub(super) fn apply_state(h: &mut ServoHealth, p: &Packet) {
     h.goal_reported = Steps(sign_magnitude(word(reg::GOAL_POSITION), 15));
 }
 
-impl Atom {
+impl ServoBank {
     /// Compares what servo `index` reports with what it was told (torque, goal) and re-sends
     /// what got lost: a SYNC WRITE has no answer, and a collision on the shared wire can
     /// swallow it or a torque write. At most [`MAX_REPAIRS`] corrections per command, and
     /// none while a command for that servo is still on its way.
-    pub(super) fn verify(&mut self, index: usize) {
-        let Some(&id) = self.config.servo_ids.get(index) else {
+    pub(super) fn verify(&mut self, settings: &Settings, index: usize) {
+        let Some(&id) = settings.config().servo_ids.get(index) else {
             return;
         };
         let Some(h) = self.health.get(index).copied() else {
             return;
         };
         let pending_goal = self
-            .pending_goals
+            .pending
             .as_ref()
             .is_some_and(|p| p.goals().get(index).copied().flatten().is_some());
         let pending_job = self.jobs.iter().any(|j| j.op.id() == id);
@@ -65,7 +66,7 @@ impl Atom {
         }
         if h.torque_reported != h.torque_on {
             let op = if h.torque_on {
-                self.torque_on_op(index, id)
+                self.torque_on_op(settings, index, id)
             } else {
                 Op::write(id, reg::TORQUE_ENABLE, &[0])
             };
@@ -77,16 +78,16 @@ impl Atom {
             && (i32::from(goal.position.0) - i32::from(h.goal_reported.0)).abs() > 1
         {
             let mut merged: GoalSet = self
-                .pending_goals
+                .pending
                 .as_ref()
                 .map(|p| *p.goals())
                 .unwrap_or([None; SERVOS]);
             if let Some(slot) = merged.get_mut(index) {
                 *slot = Some(goal);
             }
-            // Through the choke point again: the limits may have changed since.
-            match safety::check(&self.config, &self.limits, self.powered, merged) {
-                Ok(safe) => self.pending_goals = Some(safe),
+            // Through the safety check again: the limits may have changed since.
+            match safety::check(settings.config(), settings.limits(), self.powered, merged) {
+                Ok(safe) => self.pending = Some(safe),
                 Err(_) => return,
             }
         } else {

@@ -1,0 +1,480 @@
+//! The servo bank: what the Atom knows about each servo (its state, read back in turn), what it
+//! told each one (goals, torque), and the servo operations waiting for the bus.
+//!
+//! The bank is the only maker of goals: [`ServoBank::send_goals`] passes every goal through the
+//! safety check ([`crate::safety::check`]) and keeps the checked result until the bus schedule
+//! writes it. It also repairs what the shared wire lost: the state read returns each servo's
+//! torque and goal registers, and a write that did not arrive is sent again ([`readback`]).
+
+use heapless::Deque;
+use protocol_core::Frame;
+use protocol_core::command::cmd;
+use protocol_core::servo::reg;
+use protocol_core::units::{Centideg, Steps};
+
+use crate::config::{GRIPPER, JOINTS, SERVOS, STEPS_ZERO};
+use crate::driver::{Op, Outcome};
+use crate::error::AtomError;
+use crate::health::ServoHealth;
+use crate::link::Link;
+use crate::safety::{self, Goal, GoalSet, SafeGoals};
+use crate::settings::Settings;
+
+mod readback;
+
+use readback::{STATE_READ_ADDR, STATE_READ_LEN, apply_state};
+
+/// Servo operations waiting for the bus. 16: a command queues at most 3 (EEPROM unlock,
+/// write, lock) or 7 (torque on/off for every servo), and the host waits for each reply.
+pub const OP_QUEUE: usize = 16;
+
+/// A servo that stopped answering is probed only every this many refresh rounds, so a missing
+/// servo (often the gripper) does not cost its timeout in every round.
+const LOST_SERVO_PROBE_ROUNDS: u32 = 8;
+
+/// Speed at which a servo switched on outside its joint limits is pulled back inside: 10 %.
+const HOLD_SPEED_PERCENT: u8 = 10;
+
+/// How long a fresh goal counts as "moving" before the servo's own moving flag is read back:
+/// several refresh rounds (a round takes about 3 ms).
+const GOAL_CONFIRM_US: u64 = 30_000;
+
+/// Distance from its goal within which a servo counts as arrived: 10 steps, under one degree.
+const IN_POSITION_STEPS: i32 = 10;
+
+/// What to do when a queued servo operation finishes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Then {
+    /// Nothing (the host was already answered).
+    Nothing,
+    /// Answer get servo data (0x53) with the value read.
+    ReplyServoData {
+        /// Where the request came from.
+        link: Link,
+        /// True for the 2-byte form.
+        two_bytes: bool,
+    },
+}
+
+/// A servo operation waiting for the bus.
+#[derive(Clone, Debug)]
+struct Job {
+    op: Op,
+    then: Then,
+    attempt: u8,
+}
+
+/// A reply that waited for a servo operation, and the link it goes to.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Completion {
+    /// Where the request came from.
+    pub link: Link,
+    /// The reply.
+    pub reply: Frame,
+}
+
+/// The servos' state and the Atom's instructions to them. See the [module doc](self).
+#[derive(Clone, Debug)]
+pub struct ServoBank {
+    /// True while the arm is powered on (torque enabled by 0x10, until 0x11).
+    powered: bool,
+    health: [ServoHealth; SERVOS],
+    /// When each servo's state was last read.
+    read_us: [u64; SERVOS],
+    /// The goal each servo was last sent (checked), what its read-back is compared with.
+    last_goal: [Option<Goal>; SERVOS],
+    /// Corrective writes sent to each servo since its last command.
+    repairs: [u8; SERVOS],
+    /// When each servo last got a goal (it may not report moving until its next state read).
+    goal_sent_us: [u64; SERVOS],
+    /// Checked goals not written yet.
+    pending: Option<SafeGoals>,
+    jobs: Deque<Job, OP_QUEUE>,
+    refresh_next: usize,
+    refresh_rounds: u32,
+    now_us: u64,
+}
+
+impl ServoBank {
+    /// A bank for the servos of `settings`, nothing read yet.
+    pub fn new(settings: &Settings) -> Self {
+        let powered = settings.config().powered_at_boot;
+        let mut health = [ServoHealth::default(); SERVOS];
+        for h in &mut health {
+            h.position = Steps(STEPS_ZERO as i16);
+            h.torque_on = powered;
+        }
+        Self {
+            powered,
+            health,
+            read_us: [0; SERVOS],
+            last_goal: [None; SERVOS],
+            repairs: [0; SERVOS],
+            goal_sent_us: [0; SERVOS],
+            pending: None,
+            jobs: Deque::new(),
+            refresh_next: 0,
+            refresh_rounds: 0,
+            now_us: 0,
+        }
+    }
+
+    /// Sets the time of the current poll.
+    pub fn set_time(&mut self, now_us: u64) {
+        self.now_us = now_us;
+    }
+
+    /// True while the arm is powered on.
+    pub fn powered(&self) -> bool {
+        self.powered
+    }
+
+    /// Powers the arm on (torque on for every servo, holding where each one is) or off
+    /// (goals not written yet forgotten, torque off). False if an operation did not fit.
+    pub fn power(&mut self, settings: &Settings, on: bool) -> bool {
+        if !on {
+            self.pending = None;
+        }
+        self.powered = on;
+        (0..SERVOS).all(|i| self.set_torque(settings, i, on))
+    }
+
+    /// What the Atom knows about servo `index` (0..6 = joints 1..6, 6 = gripper).
+    pub fn health(&self, index: usize) -> Option<&ServoHealth> {
+        self.health.get(index)
+    }
+
+    /// Present encoder positions of the joints.
+    pub fn present_steps(&self) -> [Steps; JOINTS] {
+        core::array::from_fn(|j| self.health.get(j).map(|h| h.position).unwrap_or_default())
+    }
+
+    /// Present joint angles, from the servos' last reported positions.
+    pub fn present_angles(&self, settings: &Settings) -> [Centideg; JOINTS] {
+        let steps = self.present_steps();
+        core::array::from_fn(|j| settings.angle(j, steps.get(j).copied().unwrap_or_default()))
+    }
+
+    /// Joint `j`'s last read speed, steps per second (0 if it does not answer or holds no
+    /// torque).
+    pub fn velocity(&self, j: usize) -> i32 {
+        self.health
+            .get(j)
+            .filter(|h| h.answering && h.torque_on)
+            .map_or(0, |h| i32::from(h.speed_steps_per_s))
+    }
+
+    /// Where joint `j` is now, in thousandths of a step: its last read position moved on by
+    /// its last read speed for the time since (the reads of a round are a few ms apart).
+    pub fn estimated_millisteps(&self, j: usize) -> i64 {
+        let position = self.health.get(j).map_or(0, |h| i64::from(h.position.0));
+        let age_us = self
+            .now_us
+            .saturating_sub(self.read_us.get(j).copied().unwrap_or(0))
+            .min(20_000) as i64;
+        position * 1000 + i64::from(self.velocity(j)) * age_us / 1000
+    }
+
+    /// True while a joint that answers reports moving.
+    pub fn joints_moving(&self) -> bool {
+        self.health
+            .iter()
+            .take(JOINTS)
+            .any(|h| h.answering && h.moving)
+    }
+
+    /// True while servo `index` moves: its moving flag, or a goal sent moments ago that its
+    /// state read has not confirmed yet (so "is moving" right after a command says yes).
+    pub fn servo_moving(&self, index: usize) -> bool {
+        let Some(h) = self.health.get(index) else {
+            return false;
+        };
+        let recent = self
+            .goal_sent_us
+            .get(index)
+            .is_some_and(|&t| self.now_us.saturating_sub(t) < GOAL_CONFIRM_US);
+        let far = self
+            .last_goal
+            .get(index)
+            .copied()
+            .flatten()
+            .is_some_and(|g| {
+                (i32::from(g.position.0) - i32::from(h.position.0)).abs() > IN_POSITION_STEPS
+            });
+        h.answering && (h.moving || (recent && far))
+    }
+
+    /// True if servo `index` answers and holds torque (0x50).
+    pub fn enabled(&self, index: usize) -> bool {
+        self.health
+            .get(index)
+            .is_some_and(|h| h.answering && h.torque_on)
+    }
+
+    /// The goal servo `index` was last sent, if it holds one.
+    pub fn last_goal(&self, index: usize) -> Option<Goal> {
+        self.last_goal.get(index).copied().flatten()
+    }
+
+    /// Checks `goals` (the safety check) and, if they pass, makes them the next goals written
+    /// to the servos (merged with goals not written yet). Switches torque on for a released
+    /// servo that gets a goal.
+    pub fn send_goals(&mut self, settings: &Settings, goals: GoalSet) -> Result<(), AtomError> {
+        let safe = safety::check(settings.config(), settings.limits(), self.powered, goals)?;
+        let mut merged: GoalSet = self
+            .pending
+            .take()
+            .map(|p| *p.goals())
+            .unwrap_or([None; SERVOS]);
+        for (i, (slot, new)) in merged.iter_mut().zip(safe.goals()).enumerate() {
+            if let Some(g) = new {
+                *slot = Some(*g);
+                if let Some(last) = self.last_goal.get_mut(i) {
+                    *last = Some(*g);
+                }
+                if let Some(r) = self.repairs.get_mut(i) {
+                    *r = 0;
+                }
+                if let Some(t) = self.goal_sent_us.get_mut(i) {
+                    *t = self.now_us;
+                }
+                if self.health.get(i).is_some_and(|h| !h.torque_on) {
+                    self.set_torque(settings, i, true);
+                }
+            }
+        }
+        // Re-checking the merge cannot fail (each goal passed on its own), but keeps the
+        // invariant local: only checked goals are ever pending.
+        self.pending = Some(safety::check(
+            settings.config(),
+            settings.limits(),
+            self.powered,
+            merged,
+        )?);
+        Ok(())
+    }
+
+    /// Queues torque on/off for servo `index`; false if it could not be queued.
+    pub fn set_torque(&mut self, settings: &Settings, index: usize, on: bool) -> bool {
+        let Some(&id) = settings.config().servo_ids.get(index) else {
+            return false;
+        };
+        if on && !self.powered {
+            return false;
+        }
+        let queued = if on {
+            match self.torque_on_op(settings, index, id) {
+                Some(op) => self.queue_op(op, Then::Nothing),
+                // Position not read yet: the read-back switches it on after the first read.
+                None => true,
+            }
+        } else {
+            // A limp servo holds no goal: nothing to compare its read-back against.
+            if let Some(last) = self.last_goal.get_mut(index) {
+                *last = None;
+            }
+            Op::write(id, reg::TORQUE_ENABLE, &[0])
+                .is_some_and(|op| self.queue_op(op, Then::Nothing))
+        };
+        if queued && let Some(h) = self.health.get_mut(index) {
+            h.torque_on = on;
+            if let Some(r) = self.repairs.get_mut(index) {
+                *r = 0;
+            }
+        }
+        queued
+    }
+
+    /// The write that switches servo `index` on holding its present position (pulled into
+    /// the joint limits if the arm was moved beyond them by hand, at [`HOLD_SPEED_PERCENT`]);
+    /// `None` until the servo's position has been read. The hold goal becomes the servo's
+    /// last goal (what the read-back compares against).
+    fn torque_on_op(&mut self, settings: &Settings, index: usize, id: u8) -> Option<Op> {
+        let h = self.health.get(index)?;
+        if !h.answering {
+            return None;
+        }
+        let position = match settings.limit(index) {
+            Some(limit) => {
+                let angle = settings.angle(index, h.position);
+                let inside = Centideg(angle.0.clamp(limit.min.0, limit.max.0));
+                settings.goal_steps(index, inside)
+            }
+            None => h.position,
+        };
+        let config = settings.config();
+        let mut one: GoalSet = [None; SERVOS];
+        if let Some(slot) = one.get_mut(index) {
+            *slot = Some(Goal {
+                position,
+                speed_steps_per_s: config.joint_speed_steps(HOLD_SPEED_PERCENT) as u16,
+                accel: config.joint_accel_register(),
+            });
+        }
+        let safe = safety::check(config, settings.limits(), self.powered, one).ok()?;
+        let op = safe.torque_on_write(index, id)?;
+        if let Some(last) = self.last_goal.get_mut(index) {
+            *last = safe.goals().get(index).copied().flatten();
+        }
+        Some(op)
+    }
+
+    /// Records that servo `index` was calibrated (torque 128): its present position is now
+    /// 2048 and it holds no goal until told again.
+    pub fn calibrated(&mut self, index: usize) {
+        if let Some(h) = self.health.get_mut(index) {
+            h.position = Steps(STEPS_ZERO as i16);
+        }
+        if let Some(g) = self.last_goal.get_mut(index) {
+            *g = None;
+        }
+    }
+
+    /// Queues a servo operation. `false` if the queue is full.
+    pub fn queue_op(&mut self, op: Op, then: Then) -> bool {
+        self.jobs
+            .push_back(Job {
+                op,
+                then,
+                attempt: 0,
+            })
+            .is_ok()
+    }
+
+    /// Room for this many more servo operations.
+    pub fn op_room(&self) -> usize {
+        OP_QUEUE - self.jobs.len()
+    }
+
+    /// The servo operation of a host command that is due next (it stays queued until it
+    /// finishes: a timed-out one is retried).
+    pub fn due_job(&self) -> Option<Op> {
+        self.jobs.front().map(|j| j.op.clone())
+    }
+
+    /// The SYNC WRITE of the goals not written yet, taking them.
+    pub fn take_goal_write(&mut self, settings: &Settings) -> Option<Op> {
+        let goals = self.pending.take()?;
+        goals
+            .sync_write(&settings.config().servo_ids)
+            .map(Op::Broadcast)
+    }
+
+    /// The state read of the next servo in the refresh round (lost servos only now and then).
+    pub fn next_refresh_op(&mut self, settings: &Settings) -> Option<Op> {
+        let config = settings.config();
+        for _ in 0..SERVOS {
+            let index = self.refresh_next;
+            self.refresh_next += 1;
+            if self.refresh_next >= SERVOS {
+                self.refresh_next = 0;
+                self.refresh_rounds = self.refresh_rounds.wrapping_add(1);
+            }
+            let lost = self
+                .health
+                .get(index)
+                .is_some_and(|h| !h.answering && h.misses >= config.timing.misses_before_lost);
+            if lost && !self.refresh_rounds.is_multiple_of(LOST_SERVO_PROBE_ROUNDS) {
+                continue;
+            }
+            let id = *config.servo_ids.get(index)?;
+            return Some(Op::Read {
+                id,
+                addr: STATE_READ_ADDR,
+                count: STATE_READ_LEN,
+            });
+        }
+        None
+    }
+
+    /// Completed state-refresh rounds (every servo read once per round). Wraps.
+    pub fn refresh_rounds(&self) -> u32 {
+        self.refresh_rounds
+    }
+
+    /// Applies the result of a finished transaction; `corrupt` says the receiver saw a bad
+    /// checksum during it. Returns the reply a host request was waiting for, if any.
+    pub fn finish(
+        &mut self,
+        settings: &Settings,
+        op: Op,
+        outcome: Outcome,
+        corrupt: bool,
+    ) -> Option<Completion> {
+        let config = settings.config();
+        let index = config.servo_ids.iter().position(|&id| id == op.id());
+        let is_state_read = matches!(
+            op,
+            Op::Read {
+                addr: STATE_READ_ADDR,
+                count: STATE_READ_LEN,
+                ..
+            }
+        );
+        let job_matches = self.jobs.front().is_some_and(|j| j.op == op);
+        if is_state_read && !job_matches {
+            let i = index?;
+            let h = self.health.get_mut(i)?;
+            match &outcome {
+                Outcome::Answered(p) => {
+                    apply_state(h, p);
+                    if let Some(t) = self.read_us.get_mut(i) {
+                        *t = self.now_us;
+                    }
+                    self.verify(settings, i);
+                }
+                _ => {
+                    h.comm_errors = h.comm_errors.wrapping_add(1);
+                    h.corrupt_answers = corrupt;
+                    h.misses = h.misses.saturating_add(1);
+                    if h.misses >= config.timing.misses_before_lost {
+                        h.answering = false;
+                    }
+                }
+            }
+            return None;
+        }
+        if !job_matches {
+            return None;
+        }
+        if let (Some(h), Outcome::Answered(p)) =
+            (index.and_then(|i| self.health.get_mut(i)), &outcome)
+        {
+            h.fault_bits = p.code();
+        }
+        if outcome == Outcome::TimedOut {
+            if let Some(job) = self.jobs.front_mut()
+                && job.attempt < config.timing.retries
+            {
+                job.attempt += 1;
+                return None;
+            }
+            if let Some(h) = index.and_then(|i| self.health.get_mut(i)) {
+                h.comm_errors = h.comm_errors.wrapping_add(1);
+            }
+        }
+        let job = self.jobs.pop_front()?;
+        let Then::ReplyServoData { link, two_bytes } = job.then else {
+            return None;
+        };
+        let value: i16 = match &outcome {
+            Outcome::Answered(p) if two_bytes => p.u16_at(0).map_or(-1, |v| v as i16),
+            Outcome::Answered(p) => p.params().first().map_or(-1, |&v| i16::from(v)),
+            _ => -1,
+        };
+        let reply = if two_bytes {
+            Frame::new(cmd::GET_SERVO_DATA, &value.to_be_bytes())
+        } else {
+            Frame::new(cmd::GET_SERVO_DATA, &[value as u8])
+        }?;
+        Some(Completion { link, reply })
+    }
+
+    /// The gripper's present position.
+    pub fn gripper_position(&self) -> Steps {
+        self.health
+            .get(GRIPPER)
+            .map(|h| h.position)
+            .unwrap_or_default()
+    }
+}

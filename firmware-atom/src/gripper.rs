@@ -1,0 +1,124 @@
+//! The gripper (servo 7): its opening 0 (closed) ..= 100 (open) mapped linearly onto an encoder
+//! range, and the settings the gripper commands read back.
+
+use protocol_core::command::GripperState;
+use protocol_core::units::Steps;
+
+use crate::bank::ServoBank;
+use crate::config::{GRIPPER, GripperRange, SERVOS, STEPS_ZERO};
+use crate::error::AtomError;
+use crate::safety::{Goal, GoalSet};
+use crate::settings::Settings;
+
+/// The gripper's range and settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Gripper {
+    range: GripperRange,
+    torque: i16,
+    protect_current: i16,
+}
+
+impl Gripper {
+    /// The gripper of `settings`' configuration; torque and protection current 300 (the
+    /// vendor's defaults).
+    pub fn new(settings: &Settings) -> Self {
+        Self {
+            range: settings.config().gripper,
+            torque: 300,
+            protect_current: 300,
+        }
+    }
+
+    /// Opening 0 (closed) ..= 100 (open) from the servo's present position.
+    pub fn value(&self, bank: &ServoBank) -> u8 {
+        let pos = i32::from(bank.gripper_position().0);
+        let closed = i32::from(self.range.closed.0);
+        let span = i32::from(self.range.open.0) - closed;
+        if span == 0 {
+            return 0;
+        }
+        ((pos - closed) * 100 / span).clamp(0, 100) as u8
+    }
+
+    /// Opens (100), closes (0) or releases the gripper (0x66).
+    pub fn set_state(
+        &self,
+        bank: &mut ServoBank,
+        settings: &Settings,
+        state: GripperState,
+        speed_percent: u8,
+    ) -> Result<(), AtomError> {
+        match state {
+            GripperState::Open => self.move_to(bank, settings, 100, speed_percent),
+            GripperState::Close => self.move_to(bank, settings, 0, speed_percent),
+            GripperState::Release => {
+                if bank.set_torque(settings, GRIPPER, false) {
+                    Ok(())
+                } else {
+                    Err(AtomError::Busy)
+                }
+            }
+        }
+    }
+
+    /// Moves the gripper to opening `value` 0..=100 (0x67).
+    pub fn move_to(
+        &self,
+        bank: &mut ServoBank,
+        settings: &Settings,
+        value: u8,
+        speed_percent: u8,
+    ) -> Result<(), AtomError> {
+        let closed = i32::from(self.range.closed.0);
+        let open = i32::from(self.range.open.0);
+        let steps = closed + (open - closed) * i32::from(value.min(100)) / 100;
+        move_steps(bank, settings, Steps(steps as i16), speed_percent)
+    }
+
+    /// Follows a calibration of the gripper servo (its present position became 2048): that
+    /// is the new closed end, the span is kept.
+    pub fn calibrated(&mut self) {
+        let span = self.range.open.0 - self.range.closed.0;
+        self.range.closed = Steps(STEPS_ZERO as i16);
+        self.range.open = Steps(STEPS_ZERO as i16 + span);
+    }
+
+    /// The torque setting of the HTS gripper (0x35/0x36).
+    pub fn torque(&self) -> i16 {
+        self.torque
+    }
+
+    /// Sets the torque setting (150..=980, checked by the protocol layer).
+    pub fn set_torque(&mut self, torque: i16) {
+        self.torque = torque;
+    }
+
+    /// The protection current (0x39/0x3A).
+    pub fn protect_current(&self) -> i16 {
+        self.protect_current
+    }
+
+    /// Sets the protection current (1..=500, checked by the protocol layer).
+    pub fn set_protect_current(&mut self, current: i16) {
+        self.protect_current = current;
+    }
+}
+
+/// Moves the gripper servo to an encoder position at `speed_percent` of the joint speed.
+pub fn move_steps(
+    bank: &mut ServoBank,
+    settings: &Settings,
+    steps: Steps,
+    speed_percent: u8,
+) -> Result<(), AtomError> {
+    let config = settings.config();
+    let mut goals: GoalSet = [None; SERVOS];
+    if let Some(slot) = goals.get_mut(GRIPPER) {
+        *slot = Some(Goal {
+            position: steps,
+            speed_steps_per_s: config.joint_speed_steps(speed_percent.max(1)) as u16,
+            accel: config.joint_accel_register(),
+        });
+    }
+    bank.send_goals(settings, goals)
+}

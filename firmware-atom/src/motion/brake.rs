@@ -1,0 +1,106 @@
+//! Braking: the goals that bring every moving joint to rest as fast as the servos can, all
+//! joints together along the path they were on.
+
+use protocol_core::units::{Centideg, Steps};
+
+use crate::bank::ServoBank;
+use crate::config::{JOINTS, SERVOS, STEPS_PER_TURN};
+use crate::safety::{Goal, GoalSet};
+use crate::settings::Settings;
+
+/// Time from computing a goal to the servo acting on it, in microseconds: a transaction may be
+/// on the wire (up to about 0.6 ms), then the gap and the SYNC WRITE itself (about 0.7 ms).
+pub const GOAL_LATENCY_US: u64 = 1_500;
+
+/// Goal speed of a stopping joint that is (nearly) at rest, steps per second: lets it settle
+/// on its goal at once (a moving joint keeps its own speed: its goal lies exactly where its
+/// ramp ends, so a higher goal speed never speeds it up).
+const SETTLE_SPEED_STEPS_PER_S: u64 = 50;
+
+/// A stop: one goal per joint and when the last joint comes to rest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Braking {
+    /// The stopping goal of each joint that holds torque.
+    pub goals: [Option<Goal>; JOINTS],
+    /// Where each joint comes to rest (its present angle if it holds no torque).
+    pub rest: [Centideg; JOINTS],
+    /// Time from now until every joint is at rest, microseconds.
+    pub duration_us: u64,
+}
+
+impl Braking {
+    /// The stop of the arm as the bank last read it.
+    ///
+    /// The fastest joint brakes at the servos' full deceleration `a`
+    /// ([`crate::config::MotionLimits::servo_accel_steps_per_s2`]), so it stops after
+    /// `T = v_max / a`; every other joint brakes at `a * |v_j| / v_max` over the same `T`
+    /// (acceleration registers in 100 steps/s^2 units express every such value), so all joints
+    /// stop together, along the path they were on: a Cartesian jog or line keeps its pose while
+    /// it stops, and no joint overshoots and swings back. Each goal lies where its joint comes
+    /// to rest: its estimated present position, plus what it covers until the goal arrives
+    /// ([`GOAL_LATENCY_US`]) and while braking (`v_j * T / 2`). A stop is kept within the
+    /// joint's limits, but a joint already past a limit (the user just tightened it) stays
+    /// where it is rather than being dragged back.
+    pub fn of(bank: &ServoBank, settings: &Settings) -> Self {
+        let config = settings.config();
+        let a = i64::from(config.motion.servo_accel_steps_per_s2.max(1));
+        let v_max = (0..JOINTS)
+            .map(|j| i64::from(bank.velocity(j)).abs())
+            .max()
+            .unwrap_or(0);
+        let brake_us = v_max * 1_000_000 / a;
+        let mut goals = [None; JOINTS];
+        let present = bank.present_angles(settings);
+        let mut rest = present;
+        for j in 0..JOINTS {
+            if !bank.enabled(j) {
+                continue;
+            }
+            let v = i64::from(bank.velocity(j));
+            let travel_millisteps = v * (GOAL_LATENCY_US as i64 + brake_us / 2) / 1000;
+            let stop = (bank.estimated_millisteps(j) + travel_millisteps + 500).div_euclid(1000);
+            let stop = Steps(stop.clamp(0, i64::from(STEPS_PER_TURN) - 1) as i16);
+            let now = present.get(j).copied().unwrap_or_default();
+            let mut angle = settings.angle(j, stop);
+            if let Some(limit) = settings.limit(j) {
+                angle = angle.clamp(limit.min.min(now), limit.max.max(now));
+            }
+            let accel = if v_max == 0 {
+                config.servo_accel_register()
+            } else {
+                ((a * v.abs() + v_max * 100 - 1) / (v_max * 100)).clamp(1, 254) as u8
+            };
+            if let Some(slot) = goals.get_mut(j) {
+                *slot = Some(Goal {
+                    position: settings.goal_steps(j, angle),
+                    speed_steps_per_s: v
+                        .unsigned_abs()
+                        .clamp(SETTLE_SPEED_STEPS_PER_S, u64::from(u16::MAX))
+                        as u16,
+                    accel,
+                });
+            }
+            if let Some(r) = rest.get_mut(j) {
+                *r = angle;
+            }
+        }
+        Self {
+            goals,
+            rest,
+            duration_us: GOAL_LATENCY_US + brake_us as u64,
+        }
+    }
+
+    /// Sends the stop, one joint at a time: a joint whose stop the safety check refuses (it
+    /// stands outside its limits after being moved by hand) keeps its previous goal, and the
+    /// others still stop.
+    pub fn send(&self, bank: &mut ServoBank, settings: &Settings) {
+        for (j, goal) in self.goals.iter().enumerate() {
+            let mut one: GoalSet = [None; SERVOS];
+            if let (Some(slot), Some(g)) = (one.get_mut(j), goal) {
+                *slot = Some(*g);
+                let _ = bank.send_goals(settings, one);
+            }
+        }
+    }
+}

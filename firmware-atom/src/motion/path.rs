@@ -1,0 +1,212 @@
+//! Cartesian paths walked by the firmware: straight lines (send coords mode 1) and Cartesian
+//! jogs (0x31, 0x32), and any later path (arcs) alike.
+//!
+//! Every interpolation period the runner moves along its [`Path`] at a speed that ramps up from
+//! rest, cruises and (for a path with an end) ramps down to arrive at rest, solves the joint
+//! angles there ([`PathWalker`]) and hands them to the follower, which makes every joint reach
+//! them one period later. Where joints would have to move faster than the speed allows (next to
+//! a singularity), the walker takes a shorter step and the path slows there.
+
+use kinematics_core::{Kinematics, Line, Path, PathWalker, Ray, Transform, Turn};
+use protocol_core::units::Centideg;
+
+use crate::cartesian;
+use crate::config::{JOINTS, STEPS_PER_TURN};
+use crate::error::AtomError;
+use crate::settings::Settings;
+
+/// Micrometres per tenth of a millimetre.
+const UM_PER_TENTH_MM: i64 = 100;
+/// Path micrometres per centidegree of rotation ([`kinematics_core::path`]'s measure).
+const UM_PER_CENTIDEG: i64 = 10;
+
+/// A point of a path that moves a joint more than this from the previous point is a branch
+/// jump (error 33), however slowly the path goes: 5 deg in one interpolation period.
+const JUMP_STEP_CENTIDEG: i32 = kinematics_core::path::DEFAULT_MAX_JOINT_STEP_CENTIDEG;
+
+/// The paths the Atom walks.
+#[derive(Clone, Copy, Debug)]
+pub enum AnyPath {
+    /// A straight line to a pose.
+    Line(Line),
+    /// A Cartesian jog along a base axis.
+    Ray(Ray),
+    /// A rotation jog about a base axis.
+    Turn(Turn),
+}
+
+impl Path for AnyPath {
+    fn length_um(&self) -> i64 {
+        match self {
+            Self::Line(p) => p.length_um(),
+            Self::Ray(p) => p.length_um(),
+            Self::Turn(p) => p.length_um(),
+        }
+    }
+
+    fn pose_at(&self, at_um: i64) -> Transform {
+        match self {
+            Self::Line(p) => p.pose_at(at_um),
+            Self::Ray(p) => p.pose_at(at_um),
+            Self::Turn(p) => p.pose_at(at_um),
+        }
+    }
+}
+
+/// The next point of a path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    /// Not due yet.
+    Wait,
+    /// The joint angles one period from now; `last` at the end of the path.
+    Point {
+        /// Joint angles.
+        angles: [Centideg; JOINTS],
+        /// The end of the path.
+        last: bool,
+    },
+}
+
+/// A path being walked. See the [module doc](self).
+#[derive(Clone, Copy, Debug)]
+pub struct PathRunner {
+    walker: PathWalker<AnyPath>,
+    /// Cruising speed along the path, micrometres per second.
+    cruise_um_per_s: i64,
+    /// Speed of the last step, micrometres per second.
+    speed_um_per_s: i64,
+    /// When the next point is due.
+    next_us: u64,
+    /// Joint speed at the speed asked for, steps per second.
+    joint_speed_cap: u32,
+    /// The joint angles last handed out.
+    latest: [Centideg; JOINTS],
+}
+
+impl PathRunner {
+    /// A straight line from the joint angles `from` to `pose` at `speed_percent`.
+    pub fn line(
+        settings: &Settings,
+        now_us: u64,
+        from: &[Centideg; JOINTS],
+        pose: &protocol_core::command::Pose,
+        speed_percent: u8,
+    ) -> Result<Self, AtomError> {
+        let start = cartesian::joints(from);
+        let line = Line::new(settings.cart().model(), &start, &cartesian::to_kin(pose))?;
+        let cruise = linear_speed_um_per_s(settings, speed_percent);
+        Ok(Self::new(
+            settings,
+            now_us,
+            AnyPath::Line(line),
+            from,
+            cruise,
+            speed_percent,
+        ))
+    }
+
+    /// A Cartesian jog from the joint angles `from`: `axis` 0..2 along x, y, z, 3..5 about
+    /// the base x, y, z axes.
+    pub fn jog(
+        settings: &Settings,
+        now_us: u64,
+        from: &[Centideg; JOINTS],
+        axis: usize,
+        positive: bool,
+        speed_percent: u8,
+    ) -> Self {
+        let start = settings
+            .cart()
+            .model()
+            .forward_transform(&cartesian::joints(from));
+        let (path, cruise) = if axis < 3 {
+            let ray = AnyPath::Ray(Ray::new(start, axis, positive));
+            (ray, linear_speed_um_per_s(settings, speed_percent))
+        } else {
+            let turn = AnyPath::Turn(Turn::new(start, axis - 3, positive));
+            let cdeg_per_s = i64::from(settings.config().motion.rotation_speed_centideg_per_s)
+                * i64::from(speed_percent.clamp(1, 100))
+                / 100;
+            (turn, cdeg_per_s * UM_PER_CENTIDEG)
+        };
+        Self::new(settings, now_us, path, from, cruise, speed_percent)
+    }
+
+    fn new(
+        settings: &Settings,
+        now_us: u64,
+        path: AnyPath,
+        from: &[Centideg; JOINTS],
+        cruise_um_per_s: i64,
+        speed_percent: u8,
+    ) -> Self {
+        Self {
+            walker: PathWalker::new(path, cartesian::joints(from)),
+            cruise_um_per_s: cruise_um_per_s.max(1),
+            speed_um_per_s: 0,
+            next_us: now_us,
+            joint_speed_cap: settings.config().joint_speed_steps(speed_percent),
+            latest: *from,
+        }
+    }
+
+    /// The next point if it is due at `now_us`; an error ends the path (no solution on the
+    /// way, or a jump the joints cannot make).
+    pub fn step(&mut self, now_us: u64, settings: &Settings) -> Result<Step, AtomError> {
+        if now_us < self.next_us {
+            return Ok(Step::Wait);
+        }
+        let period_us = settings.config().timing.interpolation_period_us.max(1);
+        self.next_us = now_us + period_us;
+        let period = period_us as i64;
+        let accel =
+            i64::from(settings.config().motion.linear_accel_decimm_per_s2) * UM_PER_TENTH_MM;
+        let remaining = self.walker.remaining_um();
+        // Speed up by one period's acceleration, cruise, and slow down so that the path ends
+        // at rest: v^2 = 2 a d over the remaining distance d.
+        let mut speed = (self.speed_um_per_s + accel * period / 1_000_000)
+            .min(self.cruise_um_per_s)
+            .min(kinematics_core::fixed::sqrt(2 * accel * remaining));
+        // Never stall short of the end.
+        speed = speed
+            .max((accel * period / 2_000_000).min(self.cruise_um_per_s))
+            .max(1);
+        let advance = (speed * period / 1_000_000).max(1);
+        // The most a joint may turn in one period at the speed asked for.
+        let max_step = (i64::from(self.joint_speed_cap) * 36_000 * period
+            / (i64::from(STEPS_PER_TURN) * 1_000_000))
+            .clamp(1, i64::from(i32::MAX)) as i32;
+        let model: &Kinematics = settings.cart().model();
+        match self
+            .walker
+            .advance(model, advance, max_step, JUMP_STEP_CENTIDEG)
+        {
+            None => Ok(Step::Point {
+                angles: self.latest,
+                last: true,
+            }),
+            Some(Err(e)) => Err(e.into()),
+            Some(Ok((q, taken))) => {
+                self.speed_um_per_s = taken * 1_000_000 / period;
+                self.latest = cartesian::angles(&q);
+                Ok(Step::Point {
+                    angles: self.latest,
+                    last: self.walker.remaining_um() == 0,
+                })
+            }
+        }
+    }
+
+    /// The fastest a joint may move on this path, steps per second.
+    pub fn joint_speed_cap(&self) -> u32 {
+        self.joint_speed_cap
+    }
+}
+
+/// Cartesian speed at `speed_percent`, micrometres per second.
+fn linear_speed_um_per_s(settings: &Settings, speed_percent: u8) -> i64 {
+    i64::from(settings.config().motion.linear_speed_decimm_per_s)
+        * i64::from(speed_percent.clamp(1, 100))
+        / 100
+        * UM_PER_TENTH_MM
+}

@@ -1,0 +1,202 @@
+//! The bus schedule: who talks on the shared wire when.
+//!
+//! One servo transaction at a time ([`ServoDriver`]). Between transactions the wire stays
+//! silent for [`ATOM_TRANSACTION_GAP_US`] so the Basic can send a host frame; a frame that
+//! starts holds the schedule until it ends, and its reply goes out at once (from cached
+//! state), before the next transaction. Transactions, by priority: servo operations of host
+//! commands (torque, calibration, register access), then the newest goals, then the state
+//! refresh, which reads every servo in turn. After every non-refresh transaction one refresh
+//! read runs, so host traffic cannot starve the state refresh.
+//!
+//! Host replies on the bus: a reply whose echo comes back garbled (a collision) is sent again
+//! once the wire is quiet, up to [`REPLY_RESENDS`] times, so the host never has to resend (and
+//! never repeats an incremental jog); a frame equal to our last reply heard just after it is our
+//! own echo, not a request.
+
+use protocol_core::timing::{
+    ATOM_TRANSACTION_GAP_US, BUS_BAUD, BUS_QUIET_BEFORE_SEND_US, wire_time_us,
+};
+use protocol_core::{BytePort, Frame};
+
+use crate::bank::ServoBank;
+use crate::bus::{BusEvent, BusReceiver};
+use crate::driver::{Op, Outcome, ServoDriver};
+use crate::settings::Settings;
+
+/// How long after its last byte a frame equal to our last bus reply is taken for its echo.
+/// 300 us: far beyond the echo's arrival (tens of us), far below the time a client needs to
+/// receive that reply through the Basic and send a new request (over a millisecond at 115200).
+const OWN_REPLY_WINDOW_US: u64 = 300;
+
+/// How often a bus reply is sent again after a collision garbled it: twice, then the host's
+/// own resend takes over.
+pub const REPLY_RESENDS: u8 = 2;
+
+/// Events found in one received byte or one passage of time (a byte can complete a frame and
+/// a packet at once; a quiet line can flush both decoders).
+pub type BusEvents = heapless::Vec<BusEvent, 4>;
+
+/// The schedule of the shared bus. See the [module doc](self).
+#[derive(Clone, Debug)]
+pub struct BusSchedule {
+    rx: BusReceiver,
+    driver: ServoDriver,
+    /// A refresh read is owed after a non-refresh transaction.
+    owe_refresh: bool,
+    /// The receiver's checksum-error count when the transaction in flight started.
+    checksum_errors_at_start: u32,
+    /// A reply to send at the next chance.
+    reply: Option<Frame>,
+    /// The last reply sent and when its echo window closes.
+    last_reply: Option<(Frame, u64)>,
+    /// True while the last thing put on the bus was a host reply (so a collision reported by
+    /// the echo concerns it).
+    reply_on_wire: bool,
+    /// Resends left for the last reply.
+    reply_resends: u8,
+    /// A reply to send again once the wire is quiet (its first copy collided).
+    resend: Option<Frame>,
+}
+
+impl BusSchedule {
+    /// A schedule allowing `reply_margin_us` beyond the computed time of each servo answer.
+    pub fn new(reply_margin_us: u64) -> Self {
+        Self {
+            rx: BusReceiver::new(),
+            driver: ServoDriver::new(reply_margin_us),
+            owe_refresh: false,
+            checksum_errors_at_start: 0,
+            reply: None,
+            last_reply: None,
+            reply_on_wire: false,
+            reply_resends: 0,
+            resend: None,
+        }
+    }
+
+    /// Takes one byte heard on the bus at `now_us`; returns the frames and packets it
+    /// completes (our own reply's echo left out).
+    pub fn hear(&mut self, now_us: u64, byte: u8) -> BusEvents {
+        let mut events = BusEvents::new();
+        self.rx.push(now_us, byte, &mut |e| {
+            let _ = events.push(e);
+        });
+        self.drop_own_reply(now_us, events)
+    }
+
+    /// Handles the passage of time: frames and packets cut short by a quiet line, and a reply
+    /// that collided (queued again). Call once per poll after the received bytes.
+    pub fn on_time(&mut self, now_us: u64) -> BusEvents {
+        let mut events = BusEvents::new();
+        self.rx.on_time(now_us, &mut |e| {
+            let _ = events.push(e);
+        });
+        if self.rx.take_collision()
+            && self.reply_on_wire
+            && self.reply_resends > 0
+            && let Some((reply, _)) = &self.last_reply
+        {
+            // The Basic never got it; an incremental jog must not be resent by the host.
+            self.reply_resends -= 1;
+            self.resend = Some(reply.clone());
+        }
+        self.drop_own_reply(now_us, events)
+    }
+
+    /// Leaves out a frame equal to our last reply within its echo window (some replies, e.g.
+    /// angles to coords, have the layout of a valid request).
+    fn drop_own_reply(&self, now_us: u64, mut events: BusEvents) -> BusEvents {
+        if let Some((last, until_us)) = &self.last_reply
+            && now_us <= *until_us
+        {
+            events.retain(|e| !matches!(e, BusEvent::Frame(f) if f == last));
+        }
+        events
+    }
+
+    /// Queues `reply` for the host; a newer reply replaces an unsent one (the host has given
+    /// up on it).
+    pub fn send_reply(&mut self, reply: Frame) {
+        self.reply = Some(reply);
+    }
+
+    /// Offers a received servo packet to the transaction in flight; returns the transaction
+    /// it finished.
+    pub fn on_packet(&mut self, packet: protocol_core::servo::Packet) -> Option<(Op, Outcome)> {
+        self.driver.on_packet(packet)
+    }
+
+    /// Ends the transaction in flight if its time is up.
+    pub fn poll_driver<B: BytePort>(&mut self, now_us: u64, bus: &B) -> Option<(Op, Outcome)> {
+        self.driver.poll(now_us, bus)
+    }
+
+    /// True if the receiver saw a corrupt servo packet since the transaction in flight started.
+    pub fn saw_corruption(&self) -> bool {
+        self.rx.checksum_errors() != self.checksum_errors_at_start
+    }
+
+    /// Starts the next bus action if the wire is ours: a held host reply first, then a servo
+    /// transaction (from `bank`) once the wire has been quiet for the transaction gap.
+    pub fn start_next<B: BytePort>(
+        &mut self,
+        now_us: u64,
+        bus: &mut B,
+        bank: &mut ServoBank,
+        settings: &Settings,
+    ) {
+        if self.driver.busy() {
+            return;
+        }
+        let resend_due = self.resend.is_some()
+            && self.rx.quiet_us(now_us) >= BUS_QUIET_BEFORE_SEND_US
+            && !self.rx.frame_in_progress();
+        let fresh = self.reply.take();
+        if fresh.is_some() {
+            self.reply_resends = REPLY_RESENDS;
+            self.resend = None;
+        }
+        let reply = match fresh {
+            Some(r) => Some(r),
+            None if resend_due => self.resend.take(),
+            None => None,
+        };
+        if let Some(reply) = reply {
+            let bytes = reply.to_bytes();
+            bus.write(&bytes);
+            self.rx.on_transmit(now_us, &bytes);
+            let window_us = wire_time_us(bytes.len() as u32, BUS_BAUD) + OWN_REPLY_WINDOW_US;
+            self.last_reply = Some((reply, now_us + window_us));
+            self.reply_on_wire = true;
+            return;
+        }
+        if self.resend.is_some() {
+            // Hold the servo schedule until the resent reply is out.
+            return;
+        }
+        if self.rx.frame_in_progress()
+            || !bus.tx_idle()
+            || self.rx.quiet_us(now_us) < ATOM_TRANSACTION_GAP_US
+        {
+            return;
+        }
+        let op = if self.owe_refresh {
+            self.owe_refresh = false;
+            bank.next_refresh_op(settings)
+        } else if let Some(op) = bank.due_job() {
+            self.owe_refresh = true;
+            Some(op)
+        } else if let Some(op) = bank.take_goal_write(settings) {
+            self.owe_refresh = true;
+            Some(op)
+        } else {
+            bank.next_refresh_op(settings)
+        };
+        if let Some(op) = op
+            && self.driver.start(now_us, op, bus, &mut self.rx)
+        {
+            self.reply_on_wire = false;
+            self.checksum_errors_at_start = self.rx.checksum_errors();
+        }
+    }
+}
