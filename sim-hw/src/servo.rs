@@ -35,10 +35,19 @@ pub const SYNC_READ_SLOT_GAP_NS: u64 = 10_000;
 /// Fastest the shaft turns, in steps per second (STS3215 at 12 V, about 270 deg/s). A goal
 /// speed of 0 means this.
 pub const MAX_SPEED_STEPS_PER_S: f64 = 3_000.0;
-/// One unit of the acceleration register, in steps per second squared.
+/// One unit of the acceleration register, in steps per second squared (Feetech's memory table:
+/// "if set to 10, it corresponds to an acceleration and deceleration rate of 1000 steps per
+/// second squared"; 8.79 deg/s^2 per unit).
 pub const ACCEL_UNIT_STEPS_PER_S2: f64 = 100.0;
-/// Acceleration used when the register is 0 ("as fast as possible"), in steps/s^2.
-pub const MAX_ACCEL_STEPS_PER_S2: f64 = 100_000.0;
+/// The fastest the shaft speeds up or slows down, in steps/s^2: the acceleration when the
+/// register is 0 ("as fast as possible") and the cap of any register value. 11 400 steps/s^2
+/// is 1 000 deg/s^2 (register 114): a stop from 150 deg/s takes 0.15 s and 11 deg. Measured
+/// STS3215 models (Rhoban's `bam` and K-Scale's system identification: 0.027-0.033 kg m^2
+/// reflected at the output, 2.9 N m stall at 12 V) reach 1 200-3 300 deg/s^2 through the
+/// servo's position loop, less with the myCobot's low factory P gain and an arm to carry; this
+/// model stays below all of them, so the simulated arm never stops faster than a real one
+/// (`docs/motion.md`).
+pub const MAX_ACCEL_STEPS_PER_S2: f64 = 11_400.0;
 /// Present voltage reported, in 0.1 V (the arm's 12 V supply under load).
 pub const SUPPLY_DECIVOLT: u8 = 120;
 /// Temperature of a servo at rest, in deg C.
@@ -377,7 +386,7 @@ impl SimServo {
             };
             let accel = match self.reg(reg::ACCELERATION) {
                 0 => MAX_ACCEL_STEPS_PER_S2,
-                a => f64::from(a) * ACCEL_UNIT_STEPS_PER_S2,
+                a => (f64::from(a) * ACCEL_UNIT_STEPS_PER_S2).min(MAX_ACCEL_STEPS_PER_S2),
             };
             let error = goal - self.raw_position_steps;
             let v = self.velocity_steps_per_s;
@@ -862,6 +871,31 @@ mod tests {
     }
 
     #[test]
+    fn the_shaft_never_brakes_faster_than_a_real_sts3215() {
+        for accel in [0u8, 114, 254] {
+            let mut rig = Rig::new(&[1]);
+            rig.write(1, reg::TORQUE_ENABLE, &[1]);
+            // Full speed (1707 steps/s, 150 deg/s) towards a far goal, then a goal right where
+            // the shaft is: at 11 400 steps/s^2 it needs 128 steps to stop.
+            rig.write(1, reg::MOVE_BLOCK, &move_block(0, 4000, 1707));
+            rig.run_for_ms(400);
+            let start = rig.servo(0).present_position();
+            rig.write(1, reg::MOVE_BLOCK, &move_block(accel, start, 1707));
+            let mut furthest = start;
+            for _ in 0..400 {
+                rig.run_for_ms(1);
+                furthest = furthest.max(rig.servo(0).present_position());
+            }
+            assert!(
+                furthest - start >= 120,
+                "accel {accel}: stopped {} steps after the goal was set",
+                furthest - start
+            );
+            assert_eq!(rig.servo(0).present_position(), start, "back at its goal");
+        }
+    }
+
+    #[test]
     fn moves_backwards_too_and_respects_position_limits() {
         let mut rig = Rig::new(&[1]);
         rig.write(1, reg::TORQUE_ENABLE, &[1]);
@@ -870,7 +904,7 @@ mod tests {
         rig.write(1, reg::EEPROM_LOCK, &[1]);
         rig.write(1, reg::MOVE_BLOCK, &move_block(0, 100, 0));
         assert_eq!(rig.servo(0).goal_position(), 1500);
-        rig.run_for_ms(400);
+        rig.run_for_ms(800);
         assert_eq!(rig.servo(0).present_position(), 1500);
     }
 
@@ -903,7 +937,7 @@ mod tests {
         rig.write(1, reg::MIN_POSITION, &100u16.to_le_bytes());
         rig.write(1, reg::TORQUE_ENABLE, &[1]);
         rig.write(1, reg::MOVE_BLOCK, &move_block(0, 2500, 0));
-        rig.run_for_ms(300);
+        rig.run_for_ms(600);
         rig.servo(0).power_cycle();
         let servo = rig.servo(0);
         assert!(!servo.torque_enabled());
@@ -1002,7 +1036,7 @@ mod tests {
         }
         let trace = rig.exchange(&sync.to_packet().unwrap());
         assert!(rig.answers(&trace).is_empty());
-        rig.run_for_ms(500);
+        rig.run_for_ms(1000);
         let positions: Vec<u16> = (0..3).map(|i| rig.servo(i).present_position()).collect();
         assert_eq!(positions, vec![1000, 2048, 3000]);
     }
@@ -1039,7 +1073,7 @@ mod tests {
         rig.run_for_ms(100);
         assert_eq!(rig.servo(0).present_position(), 2048);
         rig.exchange(&Instruction::Action.to_packet(BROADCAST_ID).unwrap());
-        rig.run_for_ms(300);
+        rig.run_for_ms(600);
         assert_eq!(rig.servo(0).present_position(), 2500);
         assert_eq!(rig.servo(0).stats().goal_writes, 1);
     }
