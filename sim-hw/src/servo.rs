@@ -266,6 +266,12 @@ impl SimServo {
         (raw - self.homing_offset()).rem_euclid(4096) as u16
     }
 
+    /// Where the shaft really is, in steps with their fraction (the present position register
+    /// rounds it): the shaft minus the homing offset, for measuring motion finer than a step.
+    pub fn shaft_steps(&self) -> f64 {
+        self.raw_position_steps - f64::from(self.homing_offset())
+    }
+
     /// The goal position register, in steps.
     pub fn goal_position(&self) -> u16 {
         self.reg_u16(reg::GOAL_POSITION)

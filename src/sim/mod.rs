@@ -18,7 +18,8 @@
 //!   [`SimServo::power_cycle`], [`SimServo::move_by_hand`], [`VirtualRobot::inject_bus_noise`],
 //!   [`VirtualRobot::reset_atom`], [`VirtualRobot::reset_basic`], and [`RobotConfig`] for echo
 //!   wiring, a robot without a Basic, and the firmware configurations;
-//! * look: [`VirtualRobot::measured_angles`] (where the shafts really are), the servos' tables
+//! * look: [`VirtualRobot::measured_angles`] (where the shafts really are),
+//!   [`VirtualRobot::shaft_angles_deg`] and [`measure`] (the flange's true pose), the servos' tables
 //!   and [`ServoStats`], and every byte on the bus with its sender and times
 //!   ([`Bus::set_tracing`], [`Bus::take_trace`]).
 //!
@@ -31,6 +32,7 @@
 //! assert_eq!(robot.servo(1).map(|s| s.present_position()), Some(2048));
 //! ```
 
+pub mod measure;
 mod robot;
 
 pub use sim_hw::{servo, wire};

@@ -496,6 +496,24 @@ impl VirtualRobot {
         })
     }
 
+    /// Joint angles in degrees from the shafts' true positions (finer than the servos' step;
+    /// [`super::measure`] turns them into the true pose of the flange).
+    pub fn shaft_angles_deg(&self) -> [f64; 6] {
+        let config = self.atom.config();
+        std::array::from_fn(|j| {
+            let steps = config
+                .servo_ids
+                .get(j)
+                .and_then(|&id| self.servo(id))
+                .map_or(2048.0, |s| s.shaft_steps());
+            let degrees = (steps - 2048.0) * 360.0 / 4096.0;
+            match config.joint_signs.get(j) {
+                Some(firmware_atom::JointSign::Negative) => -degrees,
+                _ => degrees,
+            }
+        })
+    }
+
     /// The simulated servo with bus id `id` (its present register 5).
     pub fn servo(&self, id: u8) -> Option<&SimServo> {
         self.servos.get(id)

@@ -5,8 +5,8 @@
 //! interpolation period). Each joint gets the goal speed that carries it from where it is now
 //! to the target in that time, so it passes the target just as the next one arrives. Its goal
 //! lies beyond the target by the distance the servo needs to brake from that speed (plus a
-//! quarter period for a late target), so the servo never starts braking while targets keep
-//! coming; the last target of a sequence is the goal itself.
+//! quarter period for a late target and a step for rounding), so the servo never starts
+//! braking while targets keep coming; the last target of a sequence is the goal itself.
 
 use protocol_core::units::{Centideg, Steps};
 
@@ -15,44 +15,140 @@ use crate::config::{JOINTS, SERVOS, STEPS_PER_TURN};
 use crate::safety::{Goal, GoalSet};
 use crate::settings::Settings;
 
-/// The goals that carry the joints to `target` in `period_us` and on (see the
-/// [module doc](self)), no joint faster than `speed_cap_steps_per_s`. `last`: the sequence
-/// ends here, stop at `target`.
-pub fn goals_towards(
-    bank: &ServoBank,
-    settings: &Settings,
-    target: &[Centideg; JOINTS],
-    period_us: u64,
-    speed_cap_steps_per_s: u32,
-    last: bool,
-) -> GoalSet {
-    let config = settings.config();
-    let a = i64::from(config.motion.servo_accel_steps_per_s2.max(1));
-    let period = period_us.max(1) as i64;
-    let cap = i64::from(speed_cap_steps_per_s.max(1));
-    let mut goals: GoalSet = [None; SERVOS];
-    for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
-        if !bank.health(j).is_some_and(|h| h.answering) {
-            continue;
-        }
-        let angle = target.get(j).copied().unwrap_or_default();
-        let to = config.angle_to_millisteps(j, i32::from(angle.0));
-        let from = bank.estimated_millisteps(j);
-        // Thousandths of a step per microsecond = steps per millisecond: times 1000 is steps/s.
-        let speed = ((to - from) * 1000 / period).clamp(-cap, cap);
-        let beyond = if last {
-            0
-        } else {
-            speed * speed.abs() * 1000 / (2 * a) + speed * period / 4000
-        };
-        let position = goal_position(settings, j, to + beyond);
-        *slot = Some(Goal {
-            position,
-            speed_steps_per_s: speed.unsigned_abs().max(1) as u16,
-            accel: config.servo_accel_register(),
+/// How much of the difference between where a joint was expected to be and where its state
+/// read (with its speed) puts it is corrected per target: a quarter. The read is whole steps
+/// and a few milliseconds old, so trusting it fully makes the joints jitter by half a step
+/// (0.15 mm at the flange); the rest of a real difference is corrected at the next targets.
+const CORRECTION: (i64, i64) = (1, 4);
+
+/// How the joints change speed between targets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pace {
+    /// Each joint at the servos' full acceleration: a stream, where each joint follows its
+    /// own targets.
+    Free,
+    /// All joints over the same time, each at the acceleration its change of speed needs: a
+    /// Cartesian path, where a joint that got to its new speed sooner than the others would
+    /// pull the end off the path.
+    Together,
+}
+
+/// Follows a sequence of targets. See the [module doc](self).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Follower {
+    /// Where each joint should be now, thousandths of a step, and the speed it was given,
+    /// steps per second (signed).
+    last: Option<([i64; JOINTS], [i64; JOINTS])>,
+}
+
+impl Follower {
+    /// The goals that carry the joints to `target` in `period_us` and on (see the
+    /// [module doc](self)), no joint faster than `speed_cap_steps_per_s`. `last`: the sequence
+    /// ends here, stop at `target`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn goals_towards(
+        &mut self,
+        bank: &ServoBank,
+        settings: &Settings,
+        target: &[Centideg; JOINTS],
+        period_us: u64,
+        speed_cap_steps_per_s: u32,
+        pace: Pace,
+        last: bool,
+    ) -> GoalSet {
+        let config = settings.config();
+        let full = i64::from(config.motion.servo_accel_steps_per_s2.max(100));
+        let period = period_us.max(1) as i64;
+        let cap = i64::from(speed_cap_steps_per_s.max(1));
+        let answering: [bool; JOINTS] =
+            core::array::from_fn(|j| bank.health(j).is_some_and(|h| h.answering));
+        let to: [i64; JOINTS] = core::array::from_fn(|j| {
+            let angle = target.get(j).copied().unwrap_or_default();
+            let exact = config.angle_to_millisteps(j, i32::from(angle.0));
+            if last {
+                // A servo at rest holds a whole step: head for that one.
+                i64::from(goal_position(settings, j, exact).0) * 1000
+            } else {
+                exact
+            }
         });
+        let from: [i64; JOINTS] = core::array::from_fn(|j| {
+            let measured = bank.estimated_millisteps(j);
+            match &self.last {
+                Some((expected, _)) => {
+                    let e = expected.get(j).copied().unwrap_or(measured);
+                    e + (measured - e) * CORRECTION.0 / CORRECTION.1
+                }
+                _ => measured,
+            }
+        });
+        let before: [i64; JOINTS] = match &self.last {
+            Some((_, speeds)) => *speeds,
+            None => core::array::from_fn(|j| i64::from(bank.velocity(j))),
+        };
+        // Thousandths of a step per microsecond = steps per millisecond: times 1000 is steps/s.
+        let speeds: [i64; JOINTS] = core::array::from_fn(|j| {
+            let (f, t) = (
+                from.get(j).copied().unwrap_or(0),
+                to.get(j).copied().unwrap_or(0),
+            );
+            match ((t - f) * 1000 / period).clamp(-cap, cap) {
+                0 => (t - f).signum(),
+                v => v,
+            }
+        });
+        let change = |j: usize| {
+            (speeds.get(j).copied().unwrap_or(0) - before.get(j).copied().unwrap_or(0)).abs()
+        };
+        // The time every joint takes to change its speed: the largest change at full
+        // acceleration (at least a millisecond, the servos' control period).
+        let largest = (0..JOINTS)
+            .filter(|&j| answering.get(j).copied().unwrap_or(false))
+            .map(change)
+            .max()
+            .unwrap_or(0);
+        let together_us = (largest * 1_000_000 / full).max(1_000);
+        let mut goals: GoalSet = [None; SERVOS];
+        let mut expected = to;
+        for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
+            if !answering.get(j).copied().unwrap_or(false) {
+                continue;
+            }
+            let speed = speeds.get(j).copied().unwrap_or(0);
+            let accel_register = match pace {
+                Pace::Together => (change(j) * 1_000_000 / together_us)
+                    .div_euclid(100)
+                    .clamp(1, i64::from(config.servo_accel_register()))
+                    as u8,
+                _ => config.servo_accel_register(),
+            };
+            let accel = i64::from(accel_register) * 100;
+            // Braking distance, a quarter period for a late target, and one whole step so that
+            // rounding the goal to a step never puts it short of the target.
+            let beyond = if last || speed == 0 {
+                0
+            } else {
+                speed * speed.abs() * 1000 / (2 * accel)
+                    + speed * period / 4000
+                    + speed.signum() * 1000
+            };
+            let speed_register = speed.unsigned_abs().max(1) as u16;
+            let f = from.get(j).copied().unwrap_or(0);
+            if !last && let Some(e) = expected.get_mut(j) {
+                // Where the joint is one period from now at its whole-step speed: rounding the
+                // speed never adds up.
+                *e = f + speed.signum() * i64::from(speed_register) * period / 1000;
+            }
+            let t = to.get(j).copied().unwrap_or(f);
+            *slot = Some(Goal {
+                position: goal_position(settings, j, t + beyond),
+                speed_steps_per_s: speed_register,
+                accel: accel_register,
+            });
+        }
+        self.last = Some((expected, speeds));
+        goals
     }
-    goals
 }
 
 /// The encoder goal nearest `millisteps` that lies within joint `j`'s limits.

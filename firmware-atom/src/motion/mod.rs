@@ -31,6 +31,7 @@ use crate::config::JOINTS;
 use crate::error::AtomError;
 use crate::settings::Settings;
 use brake::Braking;
+use follow::{Follower, Pace};
 use path::{PathRunner, Step};
 pub use plan::{IN_POSITION_CENTIDEG, MOVE_OVERTIME_US, angles_match};
 pub use stream::STREAM_GAP_MAX_US;
@@ -115,6 +116,7 @@ enum Activity {
     /// A Cartesian path; `target` is where it ends (a line) or has got to (a jog).
     Path {
         runner: PathRunner,
+        follower: Follower,
         target: [Centideg; JOINTS],
         line: Option<Pose>,
         speed_percent: u8,
@@ -122,6 +124,7 @@ enum Activity {
     },
     /// Following a stream whose last target arrived at `last_us`.
     Stream {
+        follower: Follower,
         target: [Centideg; JOINTS],
         speed_percent: u8,
         period_us: u64,
@@ -447,6 +450,7 @@ impl MotionController {
             }
             Activity::Path {
                 runner,
+                follower,
                 target,
                 jog,
                 speed_percent,
@@ -457,8 +461,15 @@ impl MotionController {
                         *target = angles;
                     }
                     let cap = runner.joint_speed_cap();
-                    let goals =
-                        follow::goals_towards(bank, settings, &angles, period_us, cap, last);
+                    let goals = follower.goals_towards(
+                        bank,
+                        settings,
+                        &angles,
+                        period_us,
+                        cap,
+                        Pace::Together,
+                        last,
+                    );
                     bank.send_goals(settings, goals)?;
                     if last {
                         next = Some(arriving(now_us, angles, *speed_percent, period_us));
@@ -466,6 +477,7 @@ impl MotionController {
                 }
             }
             Activity::Stream {
+                follower,
                 target,
                 speed_percent,
                 period_us: stream_period_us,
@@ -473,8 +485,15 @@ impl MotionController {
             } => {
                 if stream_ended(now_us, *last_us, *stream_period_us) {
                     let cap = settings.config().joint_speed_steps(*speed_percent);
-                    let goals =
-                        follow::goals_towards(bank, settings, target, *stream_period_us, cap, true);
+                    let goals = follower.goals_towards(
+                        bank,
+                        settings,
+                        target,
+                        *stream_period_us,
+                        cap,
+                        Pace::Free,
+                        true,
+                    );
                     bank.send_goals(settings, goals)?;
                     next = Some(arriving(now_us, *target, *speed_percent, *stream_period_us));
                 }
@@ -589,6 +608,7 @@ impl MotionController {
                     PathRunner::jog(settings, now_us, &present, axis, positive, speed_percent);
                 self.activity = Activity::Path {
                     runner,
+                    follower: Follower::default(),
                     target: present,
                     line: None,
                     speed_percent,
@@ -660,6 +680,7 @@ impl MotionController {
         let runner = PathRunner::line(settings, now_us, &present, &pose, target.speed_percent)?;
         self.activity = Activity::Path {
             runner,
+            follower: Follower::default(),
             target: core::array::from_fn(|j| {
                 let here = present.get(j).copied().unwrap_or_default();
                 target.angles.get(j).copied().flatten().unwrap_or(here)
@@ -681,10 +702,16 @@ impl MotionController {
         bank: &mut ServoBank,
         settings: &Settings,
     ) -> Result<(), AtomError> {
+        let mut follower = match self.activity {
+            Activity::Stream { follower, .. } => follower,
+            _ => Follower::default(),
+        };
         let cap = settings.config().joint_speed_steps(speed_percent);
-        let goals = follow::goals_towards(bank, settings, &angles, period_us, cap, false);
+        let goals =
+            follower.goals_towards(bank, settings, &angles, period_us, cap, Pace::Free, false);
         bank.send_goals(settings, goals)?;
         self.activity = Activity::Stream {
+            follower,
             target: angles,
             speed_percent,
             period_us,

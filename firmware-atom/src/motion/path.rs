@@ -162,14 +162,19 @@ impl PathRunner {
         let accel =
             i64::from(settings.config().motion.linear_accel_decimm_per_s2) * UM_PER_TENTH_MM;
         let remaining = self.walker.remaining_um();
-        // Speed up by one period's acceleration, cruise, and slow down so that the path ends
-        // at rest: v^2 = 2 a d over the remaining distance d.
-        let mut speed = (self.speed_um_per_s + accel * period / 1_000_000)
+        // Speed up by one period's acceleration, cruise, and slow down by one period's
+        // acceleration per period so that the path ends at rest: with steps of `v P` and a
+        // speed falling by `a P` per step, the distance left d covers v = sqrt((aP/2)^2 + 2ad)
+        // - aP/2.
+        let per_period = accel * period / 1_000_000;
+        let stopping =
+            kinematics_core::fixed::sqrt(per_period * per_period / 4 + 2 * accel * remaining)
+                - per_period / 2;
+        let speed = (self.speed_um_per_s + per_period)
             .min(self.cruise_um_per_s)
-            .min(kinematics_core::fixed::sqrt(2 * accel * remaining));
-        // Never stall short of the end.
-        speed = speed
-            .max((accel * period / 2_000_000).min(self.cruise_um_per_s))
+            .min(stopping)
+            // Never stall short of the end.
+            .max(per_period.min(self.cruise_um_per_s))
             .max(1);
         let advance = (speed * period / 1_000_000).max(1);
         // The most a joint may turn in one period at the speed asked for.
@@ -188,10 +193,16 @@ impl PathRunner {
             Some(Err(e)) => Err(e.into()),
             Some(Ok((q, taken))) => {
                 self.speed_um_per_s = taken * 1_000_000 / period;
-                self.latest = cartesian::angles(&q);
+                let last = self.walker.remaining_um() == 0;
+                self.latest = if last {
+                    let end = self.walker.path().pose_at(i64::MAX);
+                    nearest_on_steps(settings, &cartesian::angles(&q), &end)
+                } else {
+                    cartesian::angles(&q)
+                };
                 Ok(Step::Point {
                     angles: self.latest,
-                    last: self.walker.remaining_um() == 0,
+                    last,
                 })
             }
         }
@@ -209,4 +220,57 @@ fn linear_speed_um_per_s(settings: &Settings, speed_percent: u8) -> i64 {
         * i64::from(speed_percent.clamp(1, 100))
         / 100
         * UM_PER_TENTH_MM
+}
+
+/// Of the joint angles on whole encoder steps around `q` (each joint's step below or above),
+/// the ones whose end pose comes nearest `end`: a servo at rest holds a whole step, and which
+/// way each joint rounds moves the end by up to a few tenths of a millimetre.
+fn nearest_on_steps(
+    settings: &Settings,
+    q: &[Centideg; JOINTS],
+    end: &Transform,
+) -> [Centideg; JOINTS] {
+    let config = settings.config();
+    let model = settings.cart().model();
+    let below: [i64; JOINTS] = core::array::from_fn(|j| {
+        let angle = q.get(j).copied().unwrap_or_default();
+        config
+            .angle_to_millisteps(j, i32::from(angle.0))
+            .div_euclid(1000)
+    });
+    let mut best = (i128::MAX, *q);
+    for choice in 0u32..(1 << JOINTS) {
+        let angles: [Centideg; JOINTS] = core::array::from_fn(|j| {
+            let step = below.get(j).copied().unwrap_or(0) + i64::from((choice >> j) & 1);
+            let step = step.clamp(0, i64::from(STEPS_PER_TURN) - 1) as i16;
+            settings.angle(j, protocol_core::units::Steps(step))
+        });
+        if settings.check_angles(&angles.map(Some)).is_err() {
+            continue;
+        }
+        let at = model.forward_transform(&cartesian::joints(&angles));
+        let miss = pose_error(&at, end);
+        if miss < best.0 {
+            best = (miss, angles);
+        }
+    }
+    best.1
+}
+
+/// A squared distance between two poses: position (internal length units) plus orientation
+/// (rotation-matrix entries, weighted so that a degree counts about as much as a millimetre).
+fn pose_error(a: &Transform, b: &Transform) -> i128 {
+    let position: i128 = a
+        .position
+        .iter()
+        .zip(&b.position)
+        .map(|(x, y)| i128::from(x - y).pow(2))
+        .sum();
+    let rotation: i128 = (0..3)
+        .flat_map(|r| (0..3).map(move |c| (r, c)))
+        .map(|(r, c)| i128::from(a.rotation.at(r, c) - b.rotation.at(r, c)).pow(2))
+        .sum();
+    // Internal lengths: 16 000 per mm; rotation entries: 2^30 per unit, a degree = 0.0175.
+    // (16 000 / (0.0175 * 2^30))^2 = 1 / 1 370 000 scales a degree to a millimetre.
+    position + rotation / 1_370_000
 }

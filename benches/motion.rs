@@ -1,0 +1,354 @@
+//! Motion quality of the real firmware under virtual time, measured at the simulated servos'
+//! shafts (their true, unquantised positions) through an independent f64 model of the arm:
+//!
+//! * **Stopping**: joint 1 jogs at 30, 60 and 100 % (45, 90, 150 deg/s), then stop (0x29);
+//!   how far it travels after the stop request's last byte, and how long until it is at rest.
+//!   Also pause (0x26) during a send_angles at 100 %.
+//! * **Streams**: fresh mode, send_angles of a smooth sine on all joints at 20, 50 and 100 Hz
+//!   (as mycobot_ros does on every joint state): the lag behind the stream beyond one period,
+//!   the residual after removing the lag (RMS and worst), and whether the stream's end is a
+//!   clean stop at its last target.
+//! * **Lines**: send_coords mode 1 and jog_coord at speed 50: the flange's largest distance from
+//!   the straight segment, and its largest turn from the orientation.
+//!
+//! `cargo bench --bench motion [stop|stream|line]`. Figures, not pass/fail; targets are printed
+//! next to them. `MOTION_TRACE=1` also prints each line's distance from its segment over time.
+
+use std::f64::consts::TAU;
+
+use open_mycobot::sim::measure::{self, FlangePose};
+use open_mycobot::sim::{RobotConfig, VirtualRobot};
+use protocol_core::command::{Axis, Direction, JointId, MoveMode, Pose, Reply, Request};
+use protocol_core::timing::{HOST_BAUD, wire_time_us};
+use protocol_core::units::{Centideg, DeciMm, SpeedPercent};
+
+/// How often the shafts are sampled, in us.
+const SAMPLE_US: u64 = 500;
+
+fn speed(percent: u8) -> SpeedPercent {
+    SpeedPercent::new(percent).expect("1..=100")
+}
+
+fn booted() -> VirtualRobot {
+    let mut robot = VirtualRobot::new(RobotConfig::default());
+    robot.run_for(1_500_000);
+    robot
+}
+
+fn ask(robot: &mut VirtualRobot, request: Request) -> Reply {
+    robot
+        .ask(&request)
+        .unwrap_or_else(|e| panic!("{request:?}: {e:?}"))
+}
+
+fn wait_until_still(robot: &mut VirtualRobot) {
+    for _ in 0..400 {
+        robot.run_for(50_000);
+        if ask(robot, Request::IsMoving) == Reply::Byte(0) {
+            return;
+        }
+    }
+    panic!("still moving");
+}
+
+fn move_to(robot: &mut VirtualRobot, degrees: [f64; 6]) {
+    let angles = degrees.map(|d| Centideg((d * 100.0).round() as i16));
+    ask(
+        robot,
+        Request::SendAngles {
+            angles,
+            speed: speed(100),
+        },
+    );
+    wait_until_still(robot);
+    robot.run_for(300_000);
+}
+
+/// Writes `request` on the Basic's USB without waiting; returns when its last byte has
+/// arrived at the Basic, in us.
+fn send(robot: &mut VirtualRobot, request: &Request) -> u64 {
+    let bytes = request.to_frame().to_bytes();
+    robot.host_write(&bytes);
+    robot.now_us() + wire_time_us(bytes.len() as u32, HOST_BAUD)
+}
+
+fn drain(robot: &mut VirtualRobot) {
+    let mut sink = Vec::new();
+    robot.host_read(&mut sink);
+}
+
+/// Travel of joint 1 after a request sent at full motion, and the time until it rests.
+struct Stop {
+    speed_deg_per_s: f64,
+    travel_deg: f64,
+    rest_s: f64,
+}
+
+fn measure_stop(robot: &mut VirtualRobot, request: Request, joint: usize) -> Stop {
+    let before = robot.shaft_angles_deg()[joint];
+    robot.run_for(10_000);
+    let speed_deg_per_s = (robot.shaft_angles_deg()[joint] - before) * 100.0;
+    let last_byte_us = send(robot, &request);
+    robot.run_until(last_byte_us);
+    let at_request = robot.shaft_angles_deg()[joint];
+    let sign = speed_deg_per_s.signum();
+    let (mut furthest, mut previous) = (0.0f64, at_request);
+    let mut last_motion_us = last_byte_us;
+    for _ in 0..(1_500_000 / SAMPLE_US) {
+        robot.run_for(SAMPLE_US);
+        let a = robot.shaft_angles_deg()[joint];
+        furthest = furthest.max((a - at_request) * sign);
+        if (a - previous).abs() > 1e-6 {
+            last_motion_us = robot.now_us();
+        }
+        previous = a;
+    }
+    drain(robot);
+    Stop {
+        speed_deg_per_s: speed_deg_per_s.abs(),
+        travel_deg: furthest,
+        rest_s: (last_motion_us - last_byte_us) as f64 / 1e6,
+    }
+}
+
+fn stops() {
+    println!("== stopping (target: <= 3 deg after the request's last byte, at rest <= 0.15 s)");
+    for percent in [30, 60, 100] {
+        let mut robot = booted();
+        move_to(&mut robot, [-160.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let joint = JointId::new(1).expect("joint 1");
+        ask(
+            &mut robot,
+            Request::JogAngle {
+                joint,
+                direction: Direction::Positive,
+                speed: speed(percent),
+            },
+        );
+        robot.run_for(1_200_000);
+        let s = measure_stop(&mut robot, Request::Stop, 0);
+        println!(
+            "stop  from jog {percent:>3} %: {:6.1} deg/s -> travel {:5.2} deg, at rest after {:.3} s",
+            s.speed_deg_per_s, s.travel_deg, s.rest_s
+        );
+    }
+    let mut robot = booted();
+    move_to(&mut robot, [-120.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    let angles = [120.0, 0.0, 0.0, 0.0, 0.0, 0.0].map(|d: f64| Centideg((d * 100.0) as i16));
+    ask(
+        &mut robot,
+        Request::SendAngles {
+            angles,
+            speed: speed(100),
+        },
+    );
+    robot.run_for(1_000_000);
+    let s = measure_stop(&mut robot, Request::Pause, 0);
+    println!(
+        "pause during send_angles 100 %: {:6.1} deg/s -> travel {:5.2} deg, at rest after {:.3} s",
+        s.speed_deg_per_s, s.travel_deg, s.rest_s
+    );
+}
+
+/// The sine the stream follows: joint angles in degrees at `t_s` seconds.
+fn sine(t_s: f64) -> [f64; 6] {
+    const AMPLITUDE: [f64; 6] = [40.0, 25.0, 30.0, 35.0, 30.0, 45.0];
+    const CENTRE: [f64; 6] = [0.0, -20.0, -40.0, 10.0, 0.0, 0.0];
+    const HZ: f64 = 0.4;
+    std::array::from_fn(|j| CENTRE[j] + AMPLITUDE[j] * (TAU * HZ * t_s + j as f64 * 0.7).sin())
+}
+
+fn to_wire(degrees: &[f64; 6]) -> [Centideg; 6] {
+    degrees.map(|d| Centideg((d * 100.0).round() as i16))
+}
+
+fn streams() {
+    println!(
+        "== streams, fresh mode, send_angles of a 0.4 Hz sine (target: lag <= 50 ms beyond one \
+         period, residual <= 0.5 deg, clean end)"
+    );
+    for rate_hz in [20u64, 50, 100] {
+        let period_us = 1_000_000 / rate_hz;
+        let mut robot = booted();
+        move_to(&mut robot, sine(0.0));
+        let start_us = robot.now_us();
+        let duration_us = 8_000_000;
+        let mut trace: Vec<(f64, [f64; 6])> = Vec::new();
+        let mut next_sample_us = start_us;
+        let mut last_target = sine(0.0);
+        while robot.now_us() < start_us + duration_us {
+            if robot.now_us() >= next_sample_us {
+                let t = (robot.now_us() - start_us) as f64 / 1e6;
+                last_target = sine(t);
+                send(
+                    &mut robot,
+                    &Request::SendAngles {
+                        angles: to_wire(&last_target),
+                        speed: speed(100),
+                    },
+                );
+                next_sample_us += period_us;
+            }
+            robot.run_for(SAMPLE_US);
+            drain(&mut robot);
+            let t = (robot.now_us() - start_us) as f64 / 1e6;
+            trace.push((t, robot.shaft_angles_deg()));
+        }
+        // Lag: the shift of the sine that fits the arm best (after a 1 s start).
+        let steady: Vec<&(f64, [f64; 6])> = trace.iter().filter(|(t, _)| *t >= 1.0).collect();
+        let fit = |lag_s: f64| -> (f64, f64) {
+            let (mut sum, mut worst, mut n) = (0.0, 0.0f64, 0.0);
+            for (t, q) in &steady {
+                let want = sine(t - lag_s);
+                for j in 0..6 {
+                    let e = q[j] - want[j];
+                    sum += e * e;
+                    worst = worst.max(e.abs());
+                    n += 1.0;
+                }
+            }
+            ((sum / n).sqrt(), worst)
+        };
+        let best_lag_ms = (0..=400)
+            .min_by(|&a, &b| {
+                fit(f64::from(a) / 1e3)
+                    .0
+                    .total_cmp(&fit(f64::from(b) / 1e3).0)
+            })
+            .unwrap_or(0);
+        let (rms, worst) = fit(f64::from(best_lag_ms) / 1e3);
+        // The end: the stream stops; the arm must come to rest at the last target.
+        robot.run_for(1_500_000);
+        drain(&mut robot);
+        let end = robot.shaft_angles_deg();
+        let end_error = (0..6)
+            .map(|j| (end[j] - last_target[j]).abs())
+            .fold(0.0, f64::max);
+        let moving = ask(&mut robot, Request::IsMoving) == Reply::Byte(1);
+        println!(
+            "{rate_hz:>3} Hz: lag {best_lag_ms} ms = period + {} ms, residual {rms:.3} deg RMS, \
+             worst {worst:.2} deg; end {end_error:.2} deg from the last target, {}",
+            best_lag_ms as i64 - (period_us / 1000) as i64,
+            if moving { "still moving" } else { "at rest" }
+        );
+    }
+}
+
+/// The flange's largest distance from the segment `a`..`b` and turn from `orientation` over
+/// `trace`.
+fn deviation(trace: &[FlangePose], a: &[f64; 3], b: &[f64; 3], start: &FlangePose) -> (f64, f64) {
+    let distance = trace
+        .iter()
+        .map(|p| measure::distance_to_segment_mm(&p.position_mm, a, b))
+        .fold(0.0, f64::max);
+    let turn = trace
+        .iter()
+        .map(|p| measure::angle_between_deg(&p.rotation, &start.rotation))
+        .fold(0.0, f64::max);
+    (distance, turn)
+}
+
+fn lines() {
+    println!("== straight lines at speed 50 (target: within 0.2 mm of the segment)");
+    let start_angles = [10.0, -30.0, -50.0, -10.0, 10.0, 20.0];
+    let offsets_mm = [
+        [-60.0, 80.0, -40.0],
+        [0.0, 0.0, -100.0],
+        [-100.0, 0.0, 0.0],
+        [-40.0, -40.0, 20.0],
+    ];
+    for d in offsets_mm {
+        let mut robot = booted();
+        move_to(&mut robot, start_angles);
+        let start = measure::flange(&robot.shaft_angles_deg());
+        let Reply::Coords(from) = ask(&mut robot, Request::GetCoords) else {
+            panic!("get_coords")
+        };
+        let to = Pose {
+            x: DeciMm(from.x.0 + (d[0] * 10.0) as i16),
+            y: DeciMm(from.y.0 + (d[1] * 10.0) as i16),
+            z: DeciMm(from.z.0 + (d[2] * 10.0) as i16),
+            ..from
+        };
+        let target = [to.x.0, to.y.0, to.z.0].map(|v| f64::from(v) / 10.0);
+        let reply = robot.ask(&Request::SendCoords {
+            pose: to,
+            speed: speed(50),
+            mode: Some(MoveMode::Linear),
+        });
+        if reply != Ok(Reply::Ack) {
+            println!("line to {to:?} refused: {reply:?}");
+            continue;
+        }
+        let mut trace = Vec::new();
+        for _ in 0..(10_000_000 / SAMPLE_US) {
+            robot.run_for(SAMPLE_US);
+            trace.push(measure::flange(&robot.shaft_angles_deg()));
+            if !robot.atom().is_moving() {
+                break;
+            }
+        }
+        if std::env::var_os("MOTION_TRACE").is_some() {
+            for (i, p) in trace.iter().enumerate().step_by(10) {
+                let dd =
+                    measure::distance_to_segment_mm(&p.position_mm, &start.position_mm, &target);
+                println!(
+                    "  t {:5.3} s  off {dd:.3} mm",
+                    i as f64 * SAMPLE_US as f64 / 1e6
+                );
+            }
+        }
+        let (distance, turn) = deviation(&trace, &start.position_mm, &target, &start);
+        let end = trace.last().map_or(start.position_mm, |p| p.position_mm);
+        let miss = measure::distance_to_segment_mm(&end, &target, &target);
+        println!(
+            "line ({:>5.0}, {:>5.0}, {:>5.0}) mm: off the segment by at most {distance:.3} mm, \
+             turned {turn:.3} deg, ends {miss:.2} mm from the target",
+            d[0], d[1], d[2]
+        );
+    }
+    for (axis, name) in [(Axis::X, "x"), (Axis::Z, "z")] {
+        let mut robot = booted();
+        move_to(&mut robot, start_angles);
+        let start = measure::flange(&robot.shaft_angles_deg());
+        ask(
+            &mut robot,
+            Request::JogCoord {
+                axis,
+                direction: Direction::Negative,
+                speed: speed(50),
+            },
+        );
+        let mut trace = Vec::new();
+        for _ in 0..(1_000_000 / SAMPLE_US) {
+            robot.run_for(SAMPLE_US);
+            trace.push(measure::flange(&robot.shaft_angles_deg()));
+        }
+        ask(&mut robot, Request::Stop);
+        wait_until_still(&mut robot);
+        trace.push(measure::flange(&robot.shaft_angles_deg()));
+        let i = if axis == Axis::X { 0 } else { 2 };
+        let mut far = start.position_mm;
+        far[i] -= 1_000.0;
+        let (distance, turn) = deviation(&trace, &start.position_mm, &far, &start);
+        let travelled = start.position_mm[i] - trace.last().map_or(0.0, |p| p.position_mm[i]);
+        println!(
+            "jog_coord -{name} 1 s: travelled {travelled:.1} mm, off the axis by at most \
+             {distance:.3} mm, turned {turn:.3} deg"
+        );
+    }
+}
+
+fn main() {
+    let only = std::env::args().nth(1).filter(|a| !a.starts_with('-'));
+    let want = |name: &str| only.as_deref().is_none_or(|o| o == name);
+    if want("stop") {
+        stops();
+    }
+    if want("stream") {
+        streams();
+    }
+    if want("line") {
+        lines();
+    }
+}

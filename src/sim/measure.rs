@@ -1,0 +1,127 @@
+//! Measuring the arm as it really is: the flange pose from the shafts' true angles, in floating
+//! point, independent of the firmware's fixed-point kinematics (same DH table,
+//! [`kinematics_core::ArmGeometry::MYCOBOT_280`]).
+
+use kinematics_core::ArmGeometry;
+
+/// A 3x3 rotation, row-major.
+pub type Rotation = [[f64; 3]; 3];
+
+/// The flange pose in the base frame: position in millimetres and orientation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlangePose {
+    /// x, y, z in millimetres.
+    pub position_mm: [f64; 3],
+    /// Orientation of the flange frame in the base frame.
+    pub rotation: Rotation,
+}
+
+/// DH alpha of each joint, degrees (`kinematics.md`).
+const ALPHA_DEG: [f64; 6] = [90.0, 0.0, 0.0, 90.0, -90.0, 0.0];
+
+/// The flange pose at joint angles `q_deg` (degrees, the protocol's joint angles).
+pub fn flange(q_deg: &[f64; 6]) -> FlangePose {
+    let g = ArmGeometry::MYCOBOT_280;
+    let mm = |um: i32| f64::from(um) / 1000.0;
+    let d = [mm(g.d1_um), 0.0, 0.0, mm(g.d4_um), mm(g.d5_um), mm(g.d6_um)];
+    let a = [0.0, mm(g.a2_um), mm(g.a3_um), 0.0, 0.0, 0.0];
+    let mut rotation = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let mut position = [0.0; 3];
+    for i in 0..6 {
+        let theta = (q_deg[i] + f64::from(g.theta_offset_centideg[i]) / 100.0).to_radians();
+        let alpha = ALPHA_DEG[i].to_radians();
+        let (st, ct, sa, ca) = (theta.sin(), theta.cos(), alpha.sin(), alpha.cos());
+        // Standard DH: Rz(theta) Tz(d) Tx(a) Rx(alpha).
+        let link_r = [
+            [ct, -st * ca, st * sa],
+            [st, ct * ca, -ct * sa],
+            [0.0, sa, ca],
+        ];
+        let link_p = [a[i] * ct, a[i] * st, d[i]];
+        let moved = apply(&rotation, &link_p);
+        for k in 0..3 {
+            position[k] += moved[k];
+        }
+        rotation = mul(&rotation, &link_r);
+    }
+    FlangePose {
+        position_mm: position,
+        rotation,
+    }
+}
+
+/// Distance in millimetres from `p` to the segment from `a` to `b`.
+pub fn distance_to_segment_mm(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let ab = sub(b, a);
+    let ap = sub(p, a);
+    let len2 = dot(&ab, &ab);
+    let t = if len2 > 0.0 {
+        (dot(&ap, &ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let closest = [a[0] + ab[0] * t, a[1] + ab[1] * t, a[2] + ab[2] * t];
+    norm(&sub(p, &closest))
+}
+
+/// Angle in degrees between two orientations.
+pub fn angle_between_deg(r1: &Rotation, r2: &Rotation) -> f64 {
+    let mut trace = 0.0;
+    for i in 0..3 {
+        for k in 0..3 {
+            trace += r1[k][i] * r2[k][i];
+        }
+    }
+    ((trace - 1.0) / 2.0).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+fn mul(x: &Rotation, y: &Rotation) -> Rotation {
+    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| x[r][k] * y[k][c]).sum()))
+}
+
+fn apply(r: &Rotation, v: &[f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| (0..3).map(|k| r[i][k] * v[k]).sum())
+}
+
+fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn norm(a: &[f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kinematics_core::{JointAngles, Kinematics};
+
+    #[test]
+    fn agrees_with_the_firmware_kinematics() {
+        let kin = Kinematics::new();
+        for q in [
+            [0, 0, 0, 0, 0, 0],
+            [3_000, -4_500, 6_000, 1_000, -2_000, 9_000],
+        ] {
+            let fixed = kin.forward(&JointAngles(q));
+            let ours = flange(&q.map(|c| f64::from(c) / 100.0));
+            for (mm, tenths) in ours.position_mm.iter().zip([fixed.x, fixed.y, fixed.z]) {
+                assert!(
+                    (mm * 10.0 - f64::from(tenths)).abs() <= 0.6,
+                    "{ours:?} {fixed:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn distance_to_a_segment() {
+        let (a, b) = ([0.0, 0.0, 0.0], [10.0, 0.0, 0.0]);
+        assert_eq!(distance_to_segment_mm(&[5.0, 3.0, 4.0], &a, &b), 5.0);
+        assert_eq!(distance_to_segment_mm(&[13.0, 4.0, 0.0], &a, &b), 5.0);
+    }
+}
