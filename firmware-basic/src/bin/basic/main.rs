@@ -58,7 +58,9 @@ const LCD_BUFFER_BYTES: usize = 512;
 fn main() -> ! {
     let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
     let mut pins = pins::take_pins!(p);
-    let _ = pins.speaker.set_low();
+    // Through the embedded-hal trait, so this line means the same on every chip: a fixed output
+    // is an `Output` on the ESP32 and a `NoPin` on the C3 stand-in, both infallible.
+    let Ok(()) = OutputPin::set_low(&mut pins.speaker);
     board_log!("open-mycobot basic {}", env!("CARGO_PKG_VERSION"));
 
     // The LCD is a nicety: without it (driver refused, panel absent) the transponder runs on.
@@ -84,7 +86,7 @@ fn main() -> ! {
     });
     let mut screen = display.and_then(|mut display| {
         display.clear(Rgb565::BLACK).ok()?;
-        let _ = pins.lcd_backlight.set_high();
+        let Ok(()) = OutputPin::set_high(&mut pins.lcd_backlight);
         Some(StatusScreen::new(display))
     });
     if screen.is_none() {
