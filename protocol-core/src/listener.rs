@@ -264,43 +264,14 @@ impl Listener {
     /// Lets time pass up to `now_us`: closes an echo window that is over and drops frames and
     /// packets cut short by a quiet line, calling `on_heard` with what that gives out. Call it
     /// once per poll, after the bytes received in that poll.
+    #[inline]
     pub fn on_time(&mut self, now_us: u64, on_heard: &mut impl FnMut(Heard)) {
-        if let Some(window) = self.window {
-            let ended = now_us >= window.end_us;
-            let verdict = if self.config.echo == EchoMode::Absent {
-                ended.then_some(Echo::Silent)
-            } else if self.echoed == 0
-                && !self.echo_required()
-                && ended
-                && now_us >= window.start_us.saturating_add(ECHO_GRACE_US)
-            {
-                Some(Echo::Silent)
-            } else if now_us >= window.end_us.saturating_add(ECHO_GRACE_US) {
-                Some(Echo::Missing)
-            } else {
-                None
-            };
-            if let Some(verdict) = verdict {
-                self.close_window(verdict, on_heard);
-            }
+        // Most polls find nothing to do: keep those to a few loads.
+        if self.window.is_some() {
+            self.judge_echo(now_us, on_heard);
         }
-        let quiet_us = self.quiet_us(now_us);
-        if self.config.packets
-            && quiet_us >= self.config.packet_gap_us
-            && self.packets.has_partial()
-        {
-            let mut next = self.packets.on_quiet_line();
-            while let Some(packet) = next {
-                on_heard(Heard::Packet(packet));
-                next = self.packets.next_packet();
-            }
-        }
-        if self.config.frames && quiet_us >= self.config.frame_gap_us && self.frames.has_partial() {
-            let mut next = self.frames.on_quiet_line();
-            while let Some(frame) = next {
-                on_heard(Heard::Frame(frame));
-                next = self.frames.next_frame();
-            }
+        if self.frames.has_partial() || self.packets.has_partial() {
+            self.cut_short(now_us, on_heard);
         }
     }
 
@@ -369,6 +340,52 @@ impl Listener {
             EchoMode::Present => true,
             EchoMode::Absent => false,
             EchoMode::Auto => self.echo_heard == Some(true),
+        }
+    }
+
+    /// Gives the open transmission its verdict once its echo window is over.
+    fn judge_echo(&mut self, now_us: u64, on_heard: &mut impl FnMut(Heard)) {
+        let Some(window) = self.window else {
+            return;
+        };
+        let ended = now_us >= window.end_us;
+        let verdict = if self.config.echo == EchoMode::Absent {
+            ended.then_some(Echo::Silent)
+        } else if self.echoed == 0
+            && !self.echo_required()
+            && ended
+            && now_us >= window.start_us.saturating_add(ECHO_GRACE_US)
+        {
+            Some(Echo::Silent)
+        } else if now_us >= window.end_us.saturating_add(ECHO_GRACE_US) {
+            Some(Echo::Missing)
+        } else {
+            None
+        };
+        if let Some(verdict) = verdict {
+            self.close_window(verdict, on_heard);
+        }
+    }
+
+    /// Drops the frames and packets in progress that a quiet line has cut short.
+    fn cut_short(&mut self, now_us: u64, on_heard: &mut impl FnMut(Heard)) {
+        let quiet_us = self.quiet_us(now_us);
+        if self.config.packets
+            && quiet_us >= self.config.packet_gap_us
+            && self.packets.has_partial()
+        {
+            let mut next = self.packets.on_quiet_line();
+            while let Some(packet) = next {
+                on_heard(Heard::Packet(packet));
+                next = self.packets.next_packet();
+            }
+        }
+        if self.config.frames && quiet_us >= self.config.frame_gap_us && self.frames.has_partial() {
+            let mut next = self.frames.on_quiet_line();
+            while let Some(frame) = next {
+                on_heard(Heard::Frame(frame));
+                next = self.frames.next_frame();
+            }
         }
     }
 
