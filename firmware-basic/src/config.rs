@@ -3,19 +3,9 @@
 
 use protocol_core::timing;
 
-/// Whether the Basic hears its own transmissions on the bus (TX and RX tied on the wire).
-/// The wiring is not documented, so the default finds out.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum EchoMode {
-    /// Decide from what comes back: an echo is checked once it has been heard; a frame that
-    /// comes back silent counts as sent until then.
-    #[default]
-    Auto,
-    /// Every transmitted byte comes back; a missing or different echo is a collision.
-    Present,
-    /// Nothing transmitted comes back; any byte heard while transmitting is a collision.
-    Absent,
-}
+/// Whether the Basic hears its own transmissions on the bus (TX and RX tied on the wire): the
+/// same setting every station's bus listener has.
+pub use protocol_core::listener::EchoMode;
 
 /// Settings of the transponder. Times in microseconds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

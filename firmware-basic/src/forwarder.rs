@@ -1,14 +1,16 @@
 //! The bus side of the transponder: sends one request at a time onto the shared wire and
 //! returns the one reply that answers it.
 //!
-//! A request is transmitted only into a quiet wire ([`timing::BUS_QUIET_BEFORE_SEND_US`]),
-//! early enough in the Atom's gap between servo transactions that the Atom hears it before it
-//! would start its next one ([`LATEST_START_IN_GAP_US`]), or once the gap has visibly ended
-//! with nobody talking ([`ATOM_START_SEEN_US`]). Its echo is read back and compared when the
-//! wiring echoes; a collision (echo differs, or a foreign byte while transmitting) is
-//! retransmitted after a growing back-off, at most [`BasicConfig::max_send_attempts`] times. An
-//! echo that is missing or cut short proves nothing (the frame may have gone out and only our
-//! receiver missed it), so it is retransmitted only if repeating the request is harmless.
+//! The forwarder hears the bus through the Basic's [`Listener`], which it is lent for each
+//! byte and each poll. A request is transmitted only into a quiet wire
+//! ([`timing::BUS_QUIET_BEFORE_SEND_US`]), early enough in the Atom's gap between servo
+//! transactions that the Atom hears it before it would start its next one
+//! ([`LATEST_START_IN_GAP_US`]), or once the gap has visibly ended with nobody talking
+//! ([`ATOM_START_SEEN_US`]). The listener reads its echo back and judges it ([`Echo`]); a
+//! collision (echo differs, or a foreign byte while transmitting) is retransmitted after a
+//! growing back-off, at most [`BasicConfig::max_send_attempts`] times. An echo that is missing
+//! or cut short proves nothing (the frame may have gone out and only our receiver missed it),
+//! so it is retransmitted only if repeating the request is harmless.
 //! Then only a complete `FE FE` frame with the request's CMD byte counts as the reply; servo
 //! packets, other frames and late duplicates are dropped, and a request that gets no reply is
 //! given up after its deadline so the next one can go. Requests wait in a bounded queue
@@ -22,9 +24,10 @@
 use heapless::{Deque, Vec};
 use protocol_core::command::cmd;
 use protocol_core::frame::{HEADER, MAX_FRAME_BYTES};
-use protocol_core::{BytePort, Frame, FrameDecoder, timing};
+use protocol_core::listener::{Echo, Heard, Listener};
+use protocol_core::{BytePort, Frame, timing};
 
-use crate::config::{BasicConfig, EchoMode};
+use crate::config::BasicConfig;
 
 /// Requests that may wait behind the one in flight. pymycobot sends one request at a time
 /// and waits for its reply; 32 absorbs a client that pipelines a burst (a request arrives
@@ -35,10 +38,6 @@ pub const REQUEST_QUEUE_DEPTH: usize = 32;
 /// client has given up on it (pymycobot resends after 0.5 s) and a command that old must not
 /// move the arm.
 pub const MAX_QUEUED_US: u64 = timing::HOST_REPLY_DEADLINE_US;
-/// How long after the transmitter went idle the rest of an echo that has started (or one the
-/// wiring is known to give) may still arrive, in microseconds: two byte times at 1 Mbaud, the
-/// receiver's latency.
-pub const ECHO_GRACE_US: u64 = 20;
 /// Bytes received further apart than this had silence between them (a new transmission
 /// began), in microseconds: one byte time and the reaction time.
 const BURST_GAP_US: u64 = timing::wire_time_us(1, timing::BUS_BAUD) + REACTION_US;
@@ -117,12 +116,9 @@ pub(crate) enum Event {
 enum Stage {
     /// Waiting for the wire to be quiet (and any back-off to pass).
     WaitQuiet { not_before_us: u64 },
-    /// On the wire; `echoed` bytes of it have come back so far.
-    Transmitting {
-        echoed: usize,
-        collided: bool,
-        tx_done_us: Option<u64>,
-    },
+    /// On the wire, until the listener's verdict on its echo; `collided` once the echo
+    /// differed (acted on when the transmitter is idle).
+    Transmitting { collided: bool },
     /// Sent; waiting for the reply until `deadline_us`. `reply_started` is whether a reply
     /// seems to have come but not as a valid frame with our CMD: an `FE` that begins a
     /// transmission (the first byte heard, or one after a silence; servo packets begin with
@@ -149,11 +145,6 @@ struct InFlight {
 pub(crate) struct Forwarder {
     queue: Deque<Request, REQUEST_QUEUE_DEPTH>,
     current: Option<InFlight>,
-    decoder: FrameDecoder,
-    /// When the wire was last busy: a byte heard, or the end of our own transmission.
-    last_activity_us: u64,
-    last_rx_us: u64,
-    echo_heard: Option<bool>,
 }
 
 impl Forwarder {
@@ -161,26 +152,7 @@ impl Forwarder {
         Self {
             queue: Deque::new(),
             current: None,
-            decoder: FrameDecoder::new(),
-            last_activity_us: 0,
-            last_rx_us: 0,
-            echo_heard: None,
         }
-    }
-
-    /// Treats the wire as busy until `now_us` (at boot, its history is unknown).
-    pub(crate) fn note_activity(&mut self, now_us: u64) {
-        self.last_activity_us = self.last_activity_us.max(now_us);
-    }
-
-    /// Whether the echo has been heard (`Some(true)`), found missing, or not tried yet.
-    pub(crate) fn echo_heard(&self) -> Option<bool> {
-        self.echo_heard
-    }
-
-    /// Records whether the wiring echoes, learned elsewhere (transparent mode).
-    pub(crate) fn set_echo_heard(&mut self, heard: bool) {
-        self.echo_heard = Some(heard);
     }
 
     /// True while a request is in flight or queued.
@@ -193,49 +165,86 @@ impl Forwarder {
         self.queue.push_back(request)
     }
 
-    /// Drops every queued and in-flight request and any partial frame (mode change).
+    /// Drops every queued and in-flight request (mode change).
     pub(crate) fn clear(&mut self) {
         self.queue.clear();
         self.current = None;
-        self.decoder = FrameDecoder::new();
     }
 
-    /// Microseconds the wire has been quiet.
-    pub(crate) fn quiet_for_us(&self, now_us: u64) -> u64 {
-        now_us.saturating_sub(self.last_activity_us)
-    }
-
-    /// Handles one byte heard on the bus at `now_us`.
+    /// Handles one byte heard on the bus at `now_us`, passing it through `listener`.
     pub(crate) fn on_bus_byte(
         &mut self,
         now_us: u64,
         byte: u8,
+        listener: &mut Listener,
         config: &BasicConfig,
         mut on_event: impl FnMut(Event),
     ) {
-        let silence_before = now_us.saturating_sub(self.last_rx_us) > BURST_GAP_US;
-        self.last_activity_us = now_us;
-        self.last_rx_us = now_us;
-        if let Some(InFlight {
-            wire,
-            stage: Stage::Transmitting {
-                echoed, collided, ..
-            },
+        let silence_before = listener.quiet_us(now_us) > BURST_GAP_US;
+        listener.push(now_us, byte, &mut |heard| {
+            self.on_heard(now_us, heard, silence_before, config, &mut on_event);
+        });
+        let garbled = matches!(
+            &self.current,
+            Some(InFlight { stage: Stage::AwaitReply { reply_started: true, .. }, request, .. })
+                if is_repeatable(&request.frame)
+        ) && !listener.frame_in_progress();
+        if garbled {
+            self.on_collision(now_us, config, &mut on_event);
+        }
+    }
+
+    /// Acts on what the listener heard; `silence_before` is whether the line was quiet
+    /// before the byte that brought it.
+    fn on_heard(
+        &mut self,
+        now_us: u64,
+        heard: Heard,
+        silence_before: bool,
+        config: &BasicConfig,
+        on_event: &mut impl FnMut(Event),
+    ) {
+        match heard {
+            Heard::Echo(echo) => self.on_echo(now_us, echo, config, on_event),
+            Heard::Byte(byte) => self.note_reply_byte(byte, silence_before),
+            Heard::Frame(frame) => self.on_frame(frame, on_event),
+            Heard::Packet(_) => {}
+        }
+    }
+
+    /// Follows the transmission in flight to its end, as the listener judged its echo.
+    fn on_echo(
+        &mut self,
+        now_us: u64,
+        echo: Echo,
+        config: &BasicConfig,
+        on_event: &mut impl FnMut(Event),
+    ) {
+        let Some(InFlight {
+            request,
+            stage: Stage::Transmitting { collided },
             ..
         }) = &mut self.current
-            && !*collided
-        {
-            if config.echo != EchoMode::Absent && wire.get(*echoed) == Some(&byte) {
-                *echoed += 1;
-                if *echoed == wire.len() {
-                    self.echo_heard = Some(true);
-                    self.start_waiting(now_us, config);
-                }
-                return;
-            }
-            // Not our echo: somebody else talked while we did.
-            *collided = true;
+        else {
+            return;
+        };
+        let repeatable = is_repeatable(&request.frame);
+        match echo {
+            // The whole echo came back, or none (the wiring does not echo, as the listener
+            // now knows): what arrives from now on is the Atom's.
+            Echo::Whole | Echo::Silent => self.start_waiting(now_us, config),
+            // The echo differed: the Atom heard the same garbled bytes. Sent again once our
+            // transmitter is idle.
+            Echo::Differed => *collided = true,
+            // The echo is missing or cut short: the frame may still have reached the Atom
+            // (bytes lost on our receive side). Send it again only if that is harmless.
+            Echo::Missing if repeatable => self.on_collision(now_us, config, on_event),
+            Echo::Missing => self.start_waiting(now_us, config),
         }
+    }
+
+    /// Notes a byte heard while waiting for the reply: whether a reply seems to have begun.
+    fn note_reply_byte(&mut self, byte: u8, silence_before: bool) {
         if let Some(InFlight {
             stage:
                 Stage::AwaitReply {
@@ -252,44 +261,38 @@ impl Forwarder {
             *last_fe = byte == HEADER && !*last_fe;
             *heard_any = true;
         }
-        let mut next = self.decoder.push(byte);
-        while let Some(frame) = next {
-            self.on_frame(frame, &mut on_event);
-            next = self.decoder.next_frame();
-        }
-        let garbled = matches!(
-            &self.current,
-            Some(InFlight { stage: Stage::AwaitReply { reply_started: true, .. }, request, .. })
-                if is_repeatable(&request.frame)
-        ) && !self.decoder.has_partial();
-        if garbled {
-            self.on_collision(now_us, config, &mut on_event);
-        }
     }
 
-    /// Checks deadlines and the transmitter; starts the next transmission when the wire
-    /// allows. Call after the bytes that arrived have been passed to [`Self::on_bus_byte`].
-    /// `room_for_reply` is false while the host link could not take another reply: the next
-    /// request then waits in the queue (a reply is often longer than its request, so a client
-    /// that pipelines requests would otherwise overrun the host link).
+    /// Lets time pass in `listener` (echo verdicts, frames cut short), checks deadlines and
+    /// the transmitter; starts the next transmission when the wire allows. Call after the bytes
+    /// that arrived have been passed to [`Self::on_bus_byte`]. `room_for_reply` is false while
+    /// the host link could not take another reply: the next request then waits in the queue (a
+    /// reply is often longer than its request, so a client that pipelines requests would
+    /// otherwise overrun the host link).
     pub(crate) fn poll<B: BytePort>(
         &mut self,
         now_us: u64,
         bus: &mut B,
+        listener: &mut Listener,
         config: &BasicConfig,
         room_for_reply: bool,
         mut on_event: impl FnMut(Event),
     ) {
-        if self.decoder.has_partial()
-            && now_us.saturating_sub(self.last_rx_us) >= timing::BUS_FRAME_GAP_US
+        let silence_before = listener.quiet_us(now_us) > BURST_GAP_US;
+        listener.on_time(now_us, &mut |heard| {
+            self.on_heard(now_us, heard, silence_before, config, &mut on_event);
+        });
+        if matches!(
+            self.current,
+            Some(InFlight {
+                stage: Stage::Transmitting { collided: true },
+                ..
+            })
+        ) && bus.tx_idle()
         {
-            let mut next = self.decoder.on_quiet_line();
-            while let Some(frame) = next {
-                self.on_frame(frame, &mut on_event);
-                next = self.decoder.next_frame();
-            }
+            // The echo differed: the Atom heard the same garbled bytes.
+            self.on_collision(now_us, config, &mut on_event);
         }
-        self.check_transmission(now_us, bus, config, &mut on_event);
         if let Some(InFlight {
             stage: Stage::AwaitReply { deadline_us, .. },
             ..
@@ -320,66 +323,7 @@ impl Forwarder {
                 stage: Stage::WaitQuiet { not_before_us: 0 },
             });
         }
-        self.try_send(now_us, bus);
-    }
-
-    /// Follows a transmission to its end: echo complete, silent, or collided.
-    fn check_transmission<B: BytePort>(
-        &mut self,
-        now_us: u64,
-        bus: &mut B,
-        config: &BasicConfig,
-        on_event: &mut impl FnMut(Event),
-    ) {
-        let echo_required = match config.echo {
-            EchoMode::Present => true,
-            EchoMode::Absent => false,
-            EchoMode::Auto => self.echo_heard == Some(true),
-        };
-        let Some(InFlight {
-            stage:
-                Stage::Transmitting {
-                    echoed,
-                    collided,
-                    tx_done_us,
-                },
-            ..
-        }) = &mut self.current
-        else {
-            return;
-        };
-        if !bus.tx_idle() {
-            return;
-        }
-        let done_at = *tx_done_us.get_or_insert(now_us);
-        self.last_activity_us = self.last_activity_us.max(done_at);
-        let collided = *collided;
-        let silent = *echoed == 0;
-        let grace_over = now_us.saturating_sub(done_at) >= ECHO_GRACE_US;
-        let repeatable = self
-            .current
-            .as_ref()
-            .is_some_and(|flight| is_repeatable(&flight.request.frame));
-        if collided {
-            // The echo differed: the Atom heard the same garbled bytes.
-            self.on_collision(now_us, config, on_event);
-        } else if grace_over && (echo_required || !silent) {
-            // The echo is missing or cut short: the frame may still have reached the Atom
-            // (bytes lost on our receive side). Send it again only if that is harmless.
-            if repeatable {
-                self.on_collision(now_us, config, on_event);
-            } else {
-                self.start_waiting(now_us, config);
-            }
-        } else if silent && !echo_required {
-            // An echo starts while the frame is still going out (byte 1 comes back while
-            // byte 2 is sent): nothing back by now means this wiring does not echo, and what
-            // arrives from now on is the Atom's.
-            if config.echo == EchoMode::Auto {
-                self.echo_heard = Some(false);
-            }
-            self.start_waiting(now_us, config);
-        }
+        self.try_send(now_us, bus, listener);
     }
 
     fn on_collision(
@@ -423,8 +367,8 @@ impl Forwarder {
     }
 
     /// Transmits the request in flight if the wire is free.
-    fn try_send<B: BytePort>(&mut self, now_us: u64, bus: &mut B) {
-        let quiet_us = self.quiet_for_us(now_us);
+    fn try_send<B: BytePort>(&mut self, now_us: u64, bus: &mut B, listener: &mut Listener) {
+        let quiet_us = listener.quiet_us(now_us);
         let Some(flight) = &mut self.current else {
             return;
         };
@@ -436,13 +380,10 @@ impl Forwarder {
         }
         // The wire is quiet: a partial frame in the decoder can no longer complete, and must not
         // swallow the reply.
-        while self.decoder.on_quiet_line().is_some() {}
+        listener.drop_partials();
         bus.write(&flight.wire);
-        flight.stage = Stage::Transmitting {
-            echoed: 0,
-            collided: false,
-            tx_done_us: None,
-        };
+        listener.on_transmit(now_us, &flight.wire);
+        flight.stage = Stage::Transmitting { collided: false };
     }
 
     fn on_frame(&mut self, frame: Frame, on_event: &mut impl FnMut(Event)) {

@@ -1,9 +1,11 @@
-//! The host side of the transponder: frames the host's byte stream (with the quiet-gap rule
-//! for truncated frames) and queues bytes for the host without ever blocking the loop.
+//! The host side of the transponder: hears the host's byte stream through a [`Listener`] (host
+//! frames only, and the host link's quiet gap for truncated frames) and queues bytes for the
+//! host without ever blocking the loop.
 
-use heapless::Deque;
-use protocol_core::frame::MAX_FRAME_BYTES;
-use protocol_core::{BytePort, Frame, FrameDecoder, timing};
+use heapless::{Deque, Vec};
+use protocol_core::frame::{MAX_FRAME_BYTES, MIN_LEN};
+use protocol_core::listener::{Heard, Listener, ListenerConfig};
+use protocol_core::{BytePort, Frame, timing};
 
 /// Bytes waiting for the host link: 44 ms of 115200. In framed mode the forwarder starts a
 /// request only while a reply of any size still fits, so replies are never dropped; in
@@ -15,59 +17,61 @@ pub const HOST_WRITE_CHUNK: usize = 64;
 /// Most host bytes taken per poll, so one poll stays short whatever the host sends.
 pub const HOST_READ_BUDGET: usize = 64;
 
-/// The host link: a framer for what arrives and a bounded queue for what leaves.
+/// How the Basic hears its host link: host frames only, cut short by the host link's gap.
+const HOST_LISTENER: ListenerConfig = ListenerConfig::new()
+    .with_packets(false)
+    .with_frame_gap_us(timing::HOST_FRAME_GAP_US);
+
+/// Most frames one host byte (or one quiet gap) can complete: the framer holds at most
+/// [`MAX_FRAME_BYTES`] bytes, and a frame takes at least `3 + MIN_LEN` of them.
+pub const MAX_FRAMES_AT_ONCE: usize = MAX_FRAME_BYTES / (3 + MIN_LEN as usize);
+
+/// The frames one host byte or one quiet gap completed, in order.
+pub(crate) type HostFrames = Vec<Frame, MAX_FRAMES_AT_ONCE>;
+
+/// The host link: a listener for what arrives and a bounded queue for what leaves.
 #[derive(Debug)]
 pub(crate) struct HostLink {
-    decoder: FrameDecoder,
-    last_rx_us: u64,
+    rx: Listener,
     tx: Deque<u8, HOST_TX_CAPACITY>,
 }
 
 impl HostLink {
     pub(crate) const fn new() -> Self {
         Self {
-            decoder: FrameDecoder::new(),
-            last_rx_us: 0,
+            rx: Listener::new(HOST_LISTENER),
             tx: Deque::new(),
         }
     }
 
-    /// Takes one byte from the host, noting when it arrived.
-    pub(crate) fn read_byte<H: BytePort>(&mut self, now_us: u64, host: &mut H) -> Option<u8> {
+    /// Takes one byte from the host at `now_us`; the frames it completes go into `frames`.
+    pub(crate) fn read_byte<H: BytePort>(
+        &mut self,
+        now_us: u64,
+        host: &mut H,
+        frames: &mut HostFrames,
+    ) -> Option<u8> {
         let byte = host.read_byte()?;
-        self.last_rx_us = now_us;
+        self.rx
+            .push(now_us, byte, &mut |heard| collect(heard, frames));
         Some(byte)
     }
 
     /// Microseconds since the last host byte arrived.
     pub(crate) fn quiet_for_us(&self, now_us: u64) -> u64 {
-        now_us.saturating_sub(self.last_rx_us)
-    }
-
-    /// Frames one host byte; returns the frame it completes (drain [`Self::next_frame`]).
-    pub(crate) fn push(&mut self, byte: u8) -> Option<Frame> {
-        self.decoder.push(byte)
-    }
-
-    /// The next frame already complete in the framer.
-    pub(crate) fn next_frame(&mut self) -> Option<Frame> {
-        self.decoder.next_frame()
+        self.rx.quiet_us(now_us)
     }
 
     /// Drops a partial frame once the host has been quiet for [`timing::HOST_FRAME_GAP_US`]
-    /// (it was cut short); returns a real frame uncovered by the rescan, if any (drain
-    /// [`Self::next_frame`]).
-    pub(crate) fn check_gap(&mut self, now_us: u64) -> Option<Frame> {
-        if self.decoder.has_partial() && self.quiet_for_us(now_us) >= timing::HOST_FRAME_GAP_US {
-            self.decoder.on_quiet_line()
-        } else {
-            None
-        }
+    /// (it was cut short); real frames uncovered by the rescan go into `frames`.
+    #[inline]
+    pub(crate) fn check_gap(&mut self, now_us: u64, frames: &mut HostFrames) {
+        self.rx.on_time(now_us, &mut |heard| collect(heard, frames));
     }
 
     /// Forgets any partial frame (when the mode changes).
     pub(crate) fn reset_framer(&mut self) {
-        self.decoder = FrameDecoder::new();
+        self.rx.drop_partials();
     }
 
     /// True if a reply frame of any size still fits in the queue.
@@ -130,5 +134,13 @@ impl HostLink {
         if let Some(bytes) = chunk.get(..n) {
             host.write(bytes);
         }
+    }
+}
+
+/// Keeps the frames a host listener heard (it hears nothing else).
+fn collect(heard: Heard, frames: &mut HostFrames) {
+    if let Heard::Frame(frame) = heard {
+        // Cannot fail: one byte or one gap completes at most MAX_FRAMES_AT_ONCE frames.
+        let _ = frames.push(frame);
     }
 }

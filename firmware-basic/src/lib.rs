@@ -20,6 +20,9 @@
 //!   `FE FE 03 C2 01 FA` and `FE FE 02 C3 FA` are still answered by the Basic then.
 //! * [`host_link`]: framing of the host stream (a frame cut by a 2 ms gap is dropped) and a
 //!   bounded output queue written only into an idle transmitter, so `poll` never blocks.
+//! * Both links are heard through `protocol_core`'s timed [`Listener`]: the host link for its
+//!   frames, the bus (one listener for framed and transparent mode) for the Atom's replies,
+//!   raw bytes, the Basic's own echo and how quiet the wire is.
 //! * At boot the Basic powers the Atom on (0x10, like the vendor transponder) and afterwards
 //!   probes it (0x12) whenever it has been silent for [`BasicConfig::probe_interval_us`]; the
 //!   replies to these internal requests never reach the host, they feed [`Basic::status`]
@@ -50,8 +53,9 @@ pub use io::{BasicIo, Buttons, NullIo};
 pub use status::{AtomLink, BasicError, BasicStatus, TransponderMode};
 
 use forwarder::{Forwarder, Origin, Request};
-use host_link::{HOST_READ_BUDGET, HostLink};
+use host_link::{HOST_READ_BUDGET, HostFrames, HostLink};
 use protocol_core::command::{Reply, cmd};
+use protocol_core::listener::{Listener, ListenerConfig};
 use protocol_core::{BytePort, Frame};
 use supervisor::Supervisor;
 use transparent::{Intercepted, Transparent};
@@ -60,12 +64,26 @@ use transparent::{Intercepted, Transparent};
 /// far more than arrives between two polls of a board's loop.
 pub const BUS_READ_BUDGET: usize = 256;
 
+/// How the Basic hears the bus: host frames (the Atom's replies) and every byte that is not its
+/// own echo (transparent mode passes them on, and they show a reply that began garbled);
+/// servo packets are none of its business.
+fn bus_listener(echo: EchoMode) -> Listener {
+    Listener::new(
+        ListenerConfig::new()
+            .with_packets(false)
+            .with_bytes(true)
+            .with_echo(echo),
+    )
+}
+
 /// The Basic's transponder: one per board, polled forever.
 #[derive(Debug)]
 pub struct Basic {
     config: BasicConfig,
     mode: TransponderMode,
     host: HostLink,
+    /// The bus as the Basic hears it, lent to the forwarder or the transparent pipe.
+    bus: Listener,
     forwarder: Forwarder,
     transparent: Transparent,
     supervisor: Supervisor,
@@ -81,6 +99,7 @@ impl Basic {
             config,
             mode: TransponderMode::Framed,
             host: HostLink::new(),
+            bus: bus_listener(config.echo),
             forwarder: Forwarder::new(),
             transparent: Transparent::default(),
             supervisor: Supervisor::new(&config),
@@ -101,7 +120,7 @@ impl Basic {
         if !self.booted {
             self.booted = true;
             // Whatever the wire was doing before we booted, give it a quiet time first.
-            self.forwarder.note_activity(now_us);
+            self.bus.assume_busy_until(now_us);
             self.supervisor.boot(now_us, &self.config);
         }
         self.read_bus(now_us, bus);
@@ -118,19 +137,20 @@ impl Basic {
                 }
                 let room_for_reply = self.host.has_room_for_frame();
                 let (supervisor, link) = (&mut self.supervisor, &mut self.host);
-                self.forwarder
-                    .poll(now_us, bus, &self.config, room_for_reply, |e| {
-                        supervisor.on_event(now_us, e, link)
-                    });
+                self.forwarder.poll(
+                    now_us,
+                    bus,
+                    &mut self.bus,
+                    &self.config,
+                    room_for_reply,
+                    |e| supervisor.on_event(now_us, e, link),
+                );
             }
             TransponderMode::Transparent => {
-                let quiet_us = self.forwarder.quiet_for_us(now_us);
-                let echo = self.echo_expected();
                 let (supervisor, link) = (&mut self.supervisor, &mut self.host);
-                let learned = self.transparent.poll(now_us, quiet_us, bus, echo, |b| {
+                self.transparent.poll(now_us, bus, &mut self.bus, |b| {
                     send_raw(link, supervisor, b)
                 });
-                self.learn_echo(learned);
             }
         }
         self.host.flush(host);
@@ -140,28 +160,9 @@ impl Basic {
     pub fn status(&self) -> BasicStatus {
         BasicStatus {
             mode: self.mode,
-            echo_heard: self.forwarder.echo_heard(),
+            echo_heard: self.bus.echo_heard(),
             transparent_dropped: self.transparent.dropped,
             ..self.supervisor.status
-        }
-    }
-
-    /// Whether the Basic hears its own bytes on the bus, if known.
-    fn echo_expected(&self) -> Option<bool> {
-        match self.config.echo {
-            EchoMode::Present => Some(true),
-            EchoMode::Absent => Some(false),
-            EchoMode::Auto => self.forwarder.echo_heard(),
-        }
-    }
-
-    /// Records what a transparent-mode write showed about the echo, while it is unknown.
-    fn learn_echo(&mut self, learned: Option<bool>) {
-        if let Some(heard) = learned
-            && self.config.echo == EchoMode::Auto
-            && self.forwarder.echo_heard().is_none()
-        {
-            self.forwarder.set_echo_heard(heard);
         }
     }
 
@@ -173,16 +174,15 @@ impl Basic {
             let (supervisor, link) = (&mut self.supervisor, &mut self.host);
             match self.mode {
                 TransponderMode::Framed => {
-                    self.forwarder.on_bus_byte(now_us, byte, &self.config, |e| {
-                        supervisor.on_event(now_us, e, link)
-                    });
+                    self.forwarder
+                        .on_bus_byte(now_us, byte, &mut self.bus, &self.config, |e| {
+                            supervisor.on_event(now_us, e, link)
+                        });
                 }
                 TransponderMode::Transparent => {
-                    self.forwarder.note_activity(now_us);
-                    let learned = self
-                        .transparent
-                        .bus_byte(byte, |b| send_raw(link, supervisor, b));
-                    self.learn_echo(learned);
+                    Transparent::bus_byte(now_us, byte, &mut self.bus, |b| {
+                        send_raw(link, supervisor, b)
+                    });
                 }
             }
         }
@@ -190,15 +190,14 @@ impl Basic {
 
     fn read_host<H: BytePort, I: BasicIo>(&mut self, now_us: u64, host: &mut H, io: &mut I) {
         for _ in 0..HOST_READ_BUDGET {
-            let Some(byte) = self.host.read_byte(now_us, host) else {
+            let mut frames = HostFrames::new();
+            let Some(byte) = self.host.read_byte(now_us, host, &mut frames) else {
                 break;
             };
             match self.mode {
                 TransponderMode::Framed => {
-                    let mut next = self.host.push(byte);
-                    while let Some(frame) = next {
+                    for frame in frames.drain(..) {
                         self.on_host_frame(now_us, frame, io);
-                        next = self.host.next_frame();
                     }
                 }
                 TransponderMode::Transparent => {
@@ -210,10 +209,12 @@ impl Basic {
         }
         match self.mode {
             TransponderMode::Framed => {
-                let mut next = self.host.check_gap(now_us);
-                while let Some(frame) = next {
-                    self.on_host_frame(now_us, frame, io);
-                    next = self.host.next_frame();
+                let mut frames = HostFrames::new();
+                self.host.check_gap(now_us, &mut frames);
+                if !frames.is_empty() {
+                    for frame in frames.drain(..) {
+                        self.on_host_frame(now_us, frame, io);
+                    }
                 }
             }
             TransponderMode::Transparent => {
@@ -264,6 +265,7 @@ impl Basic {
     fn enter_transparent(&mut self) {
         self.mode = TransponderMode::Transparent;
         self.forwarder.clear();
+        self.bus.drop_partials();
         self.host.reset_framer();
         self.transparent = Transparent::default();
     }

@@ -7,14 +7,16 @@
 //! `FE FE 02 C3 FA` (get mode: answered `01`). Host bytes that might be the start of one of
 //! them are held back until they are known not to be (or the host goes quiet for
 //! [`timing::HOST_FRAME_GAP_US`]), so these frames never reach the bus. Everything else is
-//! copied: host bytes go onto the bus only into a free wire (as framed requests do), and every bus byte goes to the
-//! host except the Basic's own echo.
+//! copied: host bytes go onto the bus only into a free wire (as framed requests do), and every
+//! bus byte goes to the host except the Basic's own echo, which the Basic's bus [`Listener`]
+//! holds back and drops (or releases, if it was not one).
 
 use heapless::{Deque, Vec};
 use protocol_core::BytePort;
+use protocol_core::listener::{Heard, Listener};
 use protocol_core::timing;
 
-use crate::forwarder::{ECHO_GRACE_US, may_start_after_quiet};
+use crate::forwarder::may_start_after_quiet;
 
 /// A host frame the Basic still answers in transparent mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,7 +50,8 @@ fn may_be_intercepted(held: &[u8]) -> bool {
 
 /// Host bytes waiting for the bus; the bus drains them 8x faster than the host fills them.
 pub const TO_BUS_CAPACITY: usize = 256;
-/// Most bytes written to the bus at once (and so most echo bytes expected back).
+/// Most bytes written to the bus at once (and so most echo bytes expected back; within the
+/// listener's [`protocol_core::listener::ECHO_CAPACITY`]).
 pub const BUS_WRITE_CHUNK: usize = 64;
 
 /// The transparent pipe's state.
@@ -57,12 +60,6 @@ pub(crate) struct Transparent {
     /// Host bytes that match the start of an intercepted frame so far.
     held: Vec<u8, INTERCEPT_MAX>,
     to_bus: Deque<u8, TO_BUS_CAPACITY>,
-    /// The last write to the bus while its echo may still come back...
-    sent: Vec<u8, BUS_WRITE_CHUNK>,
-    /// ...and how many of its bytes have come back so far (held until the echo is complete).
-    echoed: usize,
-    /// When the last write left the transmitter.
-    tx_done_us: Option<u64>,
     /// Host bytes dropped because the bus queue was full. Wraps.
     pub(crate) dropped: u32,
 }
@@ -108,58 +105,41 @@ impl Transparent {
         }
     }
 
-    /// Takes one byte from the bus and passes what is not our own echo to `emit`. An echo is
-    /// recognised only whole: bytes that match the start of our last write are held until the
-    /// rest matches too, and released if it does not. Returns `Some(true)` when a whole echo
-    /// came back.
-    pub(crate) fn bus_byte(&mut self, byte: u8, mut emit: impl FnMut(u8)) -> Option<bool> {
-        if self.sent.get(self.echoed) == Some(&byte) {
-            self.echoed += 1;
-            if self.echoed == self.sent.len() {
-                self.sent.clear();
-                self.echoed = 0;
-                return Some(true);
+    /// Takes one byte from the bus, heard through `listener`, and passes what is not the
+    /// Basic's own echo to `emit` (bytes held as a possible echo come later, if they were not).
+    pub(crate) fn bus_byte(
+        now_us: u64,
+        byte: u8,
+        listener: &mut Listener,
+        mut emit: impl FnMut(u8),
+    ) {
+        listener.push(now_us, byte, &mut |heard| {
+            if let Heard::Byte(b) = heard {
+                emit(b);
             }
-            return None;
-        }
-        self.release_echo(&mut emit);
-        emit(byte);
-        None
+        });
     }
 
-    /// Passes bytes held as a possible echo on to `emit`: they were not one.
-    fn release_echo(&mut self, emit: &mut impl FnMut(u8)) {
-        for &b in self.sent.get(..self.echoed).unwrap_or(&[]) {
-            emit(b);
-        }
-        self.sent.clear();
-        self.echoed = 0;
-    }
-
-    /// Writes queued host bytes onto the bus when the wire is free
-    /// ([`may_start_after_quiet`]). `echo` is whether the wiring echoes, if known.
-    /// Returns `Some(false)` when a write came back silent (no echo on this wiring).
+    /// Lets time pass in `listener` (bytes held as an echo that did not come back whole go to
+    /// `emit`) and writes queued host bytes onto the bus when the wire is free
+    /// ([`may_start_after_quiet`]).
     pub(crate) fn poll<B: BytePort>(
         &mut self,
         now_us: u64,
-        bus_quiet_us: u64,
         bus: &mut B,
-        echo: Option<bool>,
+        listener: &mut Listener,
         mut emit: impl FnMut(u8),
-    ) -> Option<bool> {
-        if !bus.tx_idle() {
-            return None;
-        }
-        let mut learned = None;
-        let done = *self.tx_done_us.get_or_insert(now_us);
-        if !self.sent.is_empty() && now_us.saturating_sub(done) >= ECHO_GRACE_US {
-            if self.echoed == 0 {
-                learned = Some(false);
+    ) {
+        listener.on_time(now_us, &mut |heard| {
+            if let Heard::Byte(b) = heard {
+                emit(b);
             }
-            self.release_echo(&mut emit);
-        }
-        if self.to_bus.is_empty() || !self.sent.is_empty() || !may_start_after_quiet(bus_quiet_us) {
-            return learned;
+        });
+        if self.to_bus.is_empty()
+            || !bus.tx_idle()
+            || !may_start_after_quiet(listener.quiet_us(now_us))
+        {
+            return;
         }
         let mut chunk: Vec<u8, BUS_WRITE_CHUNK> = Vec::new();
         while !chunk.is_full() {
@@ -172,11 +152,7 @@ impl Transparent {
             }
         }
         bus.write(&chunk);
-        if echo != Some(false) {
-            self.sent = chunk;
-        }
-        self.tx_done_us = None;
-        learned
+        listener.on_transmit(now_us, &chunk);
     }
 }
 
@@ -247,48 +223,61 @@ mod tests {
         assert_eq!(drain(&mut t), [0xFE, 0xFE]);
     }
 
-    fn from_bus(t: &mut Transparent, bytes: &[u8]) -> (std::vec::Vec<u8>, Option<bool>) {
-        let mut out = std::vec::Vec::new();
-        let mut learned = None;
-        for &b in bytes {
-            learned = learned.or(t.bus_byte(b, |x| out.push(x)));
-        }
-        (out, learned)
+    /// The Basic's bus listener.
+    fn listener() -> Listener {
+        crate::bus_listener(crate::EchoMode::Auto)
     }
 
-    fn write_123(t: &mut Transparent, echo: Option<bool>) {
+    /// Bytes from the bus, 10 us apart from 1 010 us (when the echo of a 3-byte write at
+    /// 1 000 us comes back): what reached the host, and whether the Basic now knows its wiring
+    /// echoes.
+    fn from_bus(bus: &mut Listener, bytes: &[u8]) -> (std::vec::Vec<u8>, Option<bool>) {
+        let mut out = std::vec::Vec::new();
+        for (i, &b) in bytes.iter().enumerate() {
+            Transparent::bus_byte(1_010 + 10 * i as u64, b, bus, |x| out.push(x));
+        }
+        (out, bus.echo_heard())
+    }
+
+    fn write_123(t: &mut Transparent, bus: &mut Listener) {
         for b in [1, 2, 3] {
             t.host_byte(b);
         }
-        let mut bus = protocol_core::NullPort;
-        t.poll(1_000, 1_000, &mut bus, echo, |_| {});
+        t.poll(1_000, &mut protocol_core::NullPort, bus, |_| {});
     }
 
     #[test]
     fn a_whole_echo_is_removed() {
-        let mut t = Transparent::default();
-        write_123(&mut t, None);
-        assert_eq!(from_bus(&mut t, &[1, 2, 3, 4]), (std::vec![4], Some(true)));
+        let (mut t, mut bus) = (Transparent::default(), listener());
+        write_123(&mut t, &mut bus);
+        assert_eq!(
+            from_bus(&mut bus, &[1, 2, 3, 4]),
+            (std::vec![4], Some(true))
+        );
     }
 
     #[test]
     fn a_reply_that_starts_like_the_request_is_not_taken_for_an_echo() {
-        let mut t = Transparent::default();
-        write_123(&mut t, None);
-        assert_eq!(from_bus(&mut t, &[1, 2, 9]), (std::vec![1, 2, 9], None));
+        let (mut t, mut bus) = (Transparent::default(), listener());
+        write_123(&mut t, &mut bus);
+        assert_eq!(from_bus(&mut bus, &[1, 2, 9]), (std::vec![1, 2, 9], None));
     }
 
     #[test]
     fn a_silent_write_means_no_echo_and_releases_nothing() {
-        let mut t = Transparent::default();
-        write_123(&mut t, None);
-        let mut bus = protocol_core::NullPort;
+        let (mut t, mut bus) = (Transparent::default(), listener());
+        write_123(&mut t, &mut bus);
         let mut out = std::vec::Vec::new();
-        t.poll(1_000, 1_000, &mut bus, None, |b| out.push(b));
-        let learned = t.poll(1_000 + ECHO_GRACE_US, 1_000, &mut bus, None, |b| {
+        t.poll(1_000, &mut protocol_core::NullPort, &mut bus, |b| {
             out.push(b)
         });
-        assert_eq!(learned, Some(false));
+        t.poll(
+            1_000 + timing::ECHO_GRACE_US,
+            &mut protocol_core::NullPort,
+            &mut bus,
+            |b| out.push(b),
+        );
+        assert_eq!(bus.echo_heard(), Some(false));
         assert!(out.is_empty());
     }
 }

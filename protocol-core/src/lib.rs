@@ -5,6 +5,8 @@
 //!   any byte stream (any chunking, garbage, servo packets on the same wire).
 //! * [`servo`]: Feetech STS servo packets `FF FF ID LEN ...`, their checksum, register values
 //!   and a streaming packet decoder.
+//! * [`listener`]: one timed listener for every station: bytes and time in; host frames, servo
+//!   packets, own echo and quiet-line handling out.
 //! * [`units`]: the protocol's units as distinct types.
 //! * [`port`]: the byte-link trait both firmwares and the virtual robot are written against.
 //! * [`timing`]: baud rates and the bus-sharing rules every station follows.
@@ -15,6 +17,7 @@
 
 pub mod command;
 pub mod frame;
+pub mod listener;
 pub mod port;
 mod scanner;
 pub mod servo;
@@ -22,4 +25,5 @@ pub mod timing;
 pub mod units;
 
 pub use frame::{Frame, FrameDecoder};
+pub use listener::{Listener, ListenerConfig};
 pub use port::{BytePort, NullPort};

@@ -12,6 +12,9 @@
 //!   its turn. A host reply is sent in that gap, before the next transaction.
 //! * A station that does transmit over another one sees its echo differ (the Basic) or a bad
 //!   checksum / no answer (the Atom) and retries.
+//! * Every station hears the wire through one [`crate::listener::Listener`]: a frame or packet
+//!   interrupted by [`BUS_FRAME_GAP_US`] / [`BUS_PACKET_GAP_US`] of silence was cut short, and
+//!   its own echo is back within [`ECHO_GRACE_US`] or not coming.
 
 /// Baud rate of the shared bus (Basic, Atom, servos).
 pub const BUS_BAUD: u32 = 1_000_000;
@@ -42,6 +45,25 @@ pub const BUS_QUIET_BEFORE_SEND_US: u64 = 60;
 pub const ATOM_TRANSACTION_GAP_US: u64 = 100;
 /// A gap this long inside a host frame on the bus means it was cut short.
 pub const BUS_FRAME_GAP_US: u64 = 200;
+/// A gap this long inside a servo packet on the bus means it was cut short, for the Atom
+/// reading servo answers: a servo (like the Atom) writes a packet in one go, back to back, so
+/// four byte times of silence inside one never happen on a healthy wire. (A tool's packet that
+/// the Basic relays in transparent mode arrives byte by byte at host speed; the servos, which
+/// must take those whole, wait longer.)
+pub const BUS_PACKET_GAP_US: u64 = 40;
+/// How long after the last byte of a transmission has left the wire its echo may still come
+/// back, for a station that hears itself: three byte times at 1 Mbaud.
+///
+/// The UART hands a byte over at its stop bit; the station reads it at its next poll (the
+/// Basic budgets one byte time for that), and a busy loop may take one byte time more. The
+/// Basic used 20 us and the Atom 30 us; one value now serves both, and it is the longer one,
+/// because the two ways to be wrong are not alike: a window that closes too early turns a late
+/// echo into a "missing" echo and into someone else's bytes (the Atom would decode its own
+/// reply as a request, a raw tool in transparent mode would get its own bytes back), while one
+/// that closes 10 us later only delays the verdict on an echo that really is missing. It is
+/// still shorter than [`BUS_QUIET_BEFORE_SEND_US`], so the verdict on one transmission is in
+/// before the Basic may start the next.
+pub const ECHO_GRACE_US: u64 = 30;
 /// A gap this long inside a host frame on a 115200 link means it was cut short (Modbus-RTU
 /// style; senders write a frame in one go).
 pub const HOST_FRAME_GAP_US: u64 = 2_000;
@@ -58,5 +80,6 @@ mod tests {
         assert_eq!(wire_time_us(5, HOST_BAUD), 435);
         const { assert!(BUS_QUIET_BEFORE_SEND_US > SERVO_TURNAROUND_MAX_US) };
         const { assert!(ATOM_TRANSACTION_GAP_US > BUS_QUIET_BEFORE_SEND_US) };
+        const { assert!(ECHO_GRACE_US < BUS_QUIET_BEFORE_SEND_US) };
     }
 }

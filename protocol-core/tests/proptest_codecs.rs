@@ -18,6 +18,9 @@ use protocol_core::servo::{Packet, PacketDecoder};
 use protocol_core::units::{Centideg, Decideg, SpeedPercent, Steps};
 use protocol_core::{Frame, FrameDecoder};
 
+mod strategies;
+use strategies::{any_frame, any_packet};
+
 // ---------- strategies ----------
 
 fn joint() -> impl Strategy<Value = JointId> {
@@ -390,20 +393,6 @@ fn host_noise() -> impl Strategy<Value = Vec<u8>> {
 
 fn servo_noise() -> impl Strategy<Value = Vec<u8>> {
     noise(0xFF)
-}
-
-fn any_frame() -> impl Strategy<Value = Frame> {
-    (any::<u8>(), prop::collection::vec(any::<u8>(), 0..=62))
-        .prop_map(|(cmd, data)| Frame::new(cmd, &data).unwrap())
-}
-
-fn any_packet() -> impl Strategy<Value = Packet> {
-    (
-        0u8..=0xFE,
-        any::<u8>(),
-        prop::collection::vec(any::<u8>(), 0..=20),
-    )
-        .prop_map(|(id, code, params)| Packet::new(id, code, &params).unwrap())
 }
 
 /// Splits `bytes` into chunks at the given (sorted, deduplicated) cut points.

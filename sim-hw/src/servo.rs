@@ -17,10 +17,9 @@
 use std::collections::VecDeque;
 
 use protocol_core::BytePort;
-use protocol_core::servo::{
-    BROADCAST_ID, Instruction, Packet, PacketDecoder, fault, reg, to_sign_magnitude,
-};
-use protocol_core::timing::{BUS_BAUD, wire_time_ns};
+use protocol_core::listener::{Heard, Listener, ListenerConfig};
+use protocol_core::servo::{BROADCAST_ID, Instruction, Packet, fault, reg, to_sign_magnitude};
+use protocol_core::timing::{BUS_BAUD, HOST_BAUD, wire_time_ns, wire_time_us};
 
 /// Time a servo takes to decode an instruction before its return delay starts, in ns. With the
 /// default return delay of 0 the answer starts 12 us after the instruction's last stop bit, well
@@ -28,8 +27,6 @@ use protocol_core::timing::{BUS_BAUD, wire_time_ns};
 pub const PROCESSING_NS: u64 = 12_000;
 /// Period of the servo's position control loop, in ns (1 kHz, like the STS firmware).
 pub const CONTROL_PERIOD_NS: u64 = 1_000_000;
-/// A gap this long inside a packet means it was cut short; the servo drops the partial packet.
-pub const PACKET_GAP_NS: u64 = 100_000;
 /// Silence between two answers of one SYNC READ, in ns.
 pub const SYNC_READ_SLOT_GAP_NS: u64 = 10_000;
 /// Fastest the shaft turns, in steps per second (STS3215 at 12 V, about 270 deg/s). A goal
@@ -118,31 +115,48 @@ pub struct ServoStats {
     pub goal_writes: u64,
 }
 
-/// Finds servo packets in the bytes heard on the bus, dropping a partial packet when the line
-/// was quiet for [`PACKET_GAP_NS`] (a packet cut short must not swallow the next one).
-/// One listener can serve every servo on the bus: they all hear the same bytes.
-#[derive(Clone, Debug, Default)]
+/// A gap this long inside a packet means it was cut short; the servo drops the partial packet.
+/// Longer than the bus stations' `timing::BUS_PACKET_GAP_US`: in transparent mode a tool's
+/// packet reaches the bus byte by byte as it arrives at the Basic at 115200 baud, one byte every
+/// 87 us, and the servos must still take it whole.
+pub const PACKET_GAP_US: u64 = 100;
+const _: () = assert!(PACKET_GAP_US > wire_time_us(1, HOST_BAUD));
+
+/// How a servo hears the bus: servo packets only, cut short by [`PACKET_GAP_US`].
+const SERVO_LISTENER: ListenerConfig = ListenerConfig::new()
+    .with_frames(false)
+    .with_packet_gap_us(PACKET_GAP_US);
+
+/// Finds servo packets in the bytes heard on the bus: protocol-core's timed [`Listener`], fed
+/// with the nanosecond times of the simulated wire. Each byte is heard at the instant it ends,
+/// so a partial packet followed by a quiet gap is dropped before the next byte (a packet cut
+/// short must not swallow the next one). One listener can serve every servo on the bus: they
+/// all hear the same bytes.
+#[derive(Clone, Debug)]
 pub struct PacketListener {
-    decoder: PacketDecoder,
-    last_byte_ns: u64,
+    listener: Listener,
+}
+
+impl Default for PacketListener {
+    fn default() -> Self {
+        Self {
+            listener: Listener::new(SERVO_LISTENER),
+        }
+    }
 }
 
 impl PacketListener {
     /// Takes one byte that arrived at `end_ns`; calls `on_packet` with each packet it completes.
     pub fn hear(&mut self, byte: u8, end_ns: u64, mut on_packet: impl FnMut(Packet)) {
-        if end_ns.saturating_sub(self.last_byte_ns) >= PACKET_GAP_NS {
-            let mut cut = self.decoder.on_quiet_line();
-            while let Some(p) = cut {
-                on_packet(p);
-                cut = self.decoder.next_packet();
+        let now_us = end_ns / 1_000;
+        let mut on_heard = |heard| {
+            if let Heard::Packet(packet) = heard {
+                on_packet(packet);
             }
-        }
-        self.last_byte_ns = end_ns;
-        let mut found = self.decoder.push(byte);
-        while let Some(p) = found {
-            on_packet(p);
-            found = self.decoder.next_packet();
-        }
+        };
+        // The silence before this byte is known exactly: let it pass first.
+        self.listener.on_time(now_us, &mut on_heard);
+        self.listener.push(now_us, byte, &mut on_heard);
     }
 }
 
@@ -656,7 +670,7 @@ impl Default for SimServo {
 mod tests {
     use super::*;
     use crate::wire::{Bus, BusByte, StationId};
-    use protocol_core::servo::{SyncWriteBuilder, sign_magnitude};
+    use protocol_core::servo::{PacketDecoder, SyncWriteBuilder, sign_magnitude};
     use protocol_core::timing::SERVO_TURNAROUND_MAX_US;
 
     /// A controller and some servos on one bus, stepped at every byte end and servo event.
@@ -770,6 +784,29 @@ mod tests {
         block.extend_from_slice(&[0, 0]);
         block.extend_from_slice(&speed.to_le_bytes());
         block
+    }
+
+    #[test]
+    fn a_packet_cut_short_does_not_swallow_the_next_one() {
+        let mut listener = PacketListener::default();
+        let mut heard = Vec::new();
+        let read = Instruction::Read { addr: 56, count: 2 }
+            .to_packet(2)
+            .unwrap();
+        // The start of a long WRITE (LEN 0x40: 68 bytes), then, after a silence, a whole READ
+        // (bytes 10 us apart). Without the silence the READ would be taken for the WRITE's
+        // parameters.
+        let mut t_ns = 0;
+        for &b in &[0xFF, 0xFF, 0x01, 0x40, 0x03] {
+            t_ns += 10_000;
+            listener.hear(b, t_ns, |p| heard.push(p));
+        }
+        t_ns += PACKET_GAP_US * 1_000;
+        for &b in read.to_bytes().iter() {
+            t_ns += 10_000;
+            listener.hear(b, t_ns, |p| heard.push(p));
+        }
+        assert_eq!(heard, [read]);
     }
 
     #[test]

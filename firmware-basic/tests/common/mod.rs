@@ -10,6 +10,7 @@
 use std::collections::VecDeque;
 
 use firmware_basic::{Basic, BasicConfig, BasicIo, Buttons};
+use protocol_core::listener::{Heard, Listener, ListenerConfig};
 use protocol_core::{BytePort, Frame, FrameDecoder, timing};
 use sim_hw::{Bus, HeardByte, StationId};
 
@@ -300,7 +301,8 @@ pub struct Rig {
     pub now_ns: u64,
     /// Poll period, ns.
     pub step_ns: u64,
-    atom_decoder: FrameDecoder,
+    /// How the scripted Atom hears the Basic: host frames, the bus frame gap.
+    atom_rx: Listener,
     /// Frames the Atom received intact, with the time (ns) their last byte ended.
     pub atom_got: Vec<(u64, Frame)>,
     /// The Atom's replies: when each started on the wire (ns) and its bytes.
@@ -309,7 +311,6 @@ pub struct Rig {
     pub atom: Responder,
     /// Time from the end of a request to the start of the Atom's answer, ns.
     pub atom_delay_ns: u64,
-    atom_last_rx_ns: u64,
 }
 
 impl Rig {
@@ -322,12 +323,11 @@ impl Rig {
             io: MemIo::default(),
             now_ns: 0,
             step_ns: 1_000,
-            atom_decoder: FrameDecoder::new(),
+            atom_rx: Listener::new(ListenerConfig::new().with_packets(false)),
             atom_got: Vec::new(),
             atom_sent: Vec::new(),
             atom: ack_everything(),
             atom_delay_ns: 200_000,
-            atom_last_rx_ns: 0,
         }
     }
 
@@ -403,11 +403,14 @@ impl Rig {
         let heard: Vec<(u64, u8)> = self.wire.atom_rx.drain(..).collect();
         let mut frames = Vec::new();
         for (at, b) in heard {
-            if at.saturating_sub(self.atom_last_rx_ns) > timing::BUS_FRAME_GAP_US * 1_000 {
-                while self.atom_decoder.on_quiet_line().is_some() {}
-            }
-            self.atom_last_rx_ns = at;
-            self.atom_decoder.feed(&[b], |f| frames.push((at, f)));
+            // Each byte is heard when it ends: the silence before it passes first.
+            let mut on_heard = |h| {
+                if let Heard::Frame(f) = h {
+                    frames.push((at, f));
+                }
+            };
+            self.atom_rx.on_time(at / 1_000, &mut on_heard);
+            self.atom_rx.push(at / 1_000, b, &mut on_heard);
         }
         for (at, frame) in frames {
             self.atom_got.push((at, frame.clone()));

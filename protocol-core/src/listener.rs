@@ -1,0 +1,716 @@
+//! The one timed listener every station hears a wire through: received bytes with their time
+//! and the station's own transmissions in; host frames, servo packets, raw bytes and a verdict
+//! on each transmission's echo out.
+//!
+//! The Atom and the Basic hear the shared bus with it, the Basic also its host link, and the
+//! simulated servos the bus. What differs between them is a [`ListenerConfig`]: which decoders
+//! run, how long a silence cuts a frame or a packet short, and whether the station hears its
+//! own bytes ([`EchoMode`]).
+//!
+//! * **Quiet line.** A sender writes a frame or packet in one go, so a partial one followed by
+//!   silence was cut short: [`Listener::on_time`] drops it once the line has been quiet for the
+//!   frame gap (`BUS_FRAME_GAP_US` on the bus, `HOST_FRAME_GAP_US` on a host link) or the
+//!   packet gap ([`BUS_PACKET_GAP_US`]), and anything complete found inside it comes out.
+//!   Only `on_time` applies the gaps: a station that reads the bytes of one poll late stamps
+//!   them late, and that must not look like a silence before them.
+//! * **Own echo.** Whether a station hears its own transmissions depends on the wiring. Every
+//!   byte it sends ([`Listener::on_transmit`]) is expected back until the echo window closes
+//!   ([`ECHO_GRACE_US`] after the transmission's end). Received bytes that match the expected
+//!   echo are held back: a whole match is dropped as echo; at the first difference, or when the
+//!   window closes first, the held bytes are released to the decoders in order (the line did
+//!   not echo and they were another station's, or a collision changed them). Each
+//!   transmission gets one [`Echo`] verdict, which is what the Basic decides retransmissions
+//!   on, and a collision on a line known to echo is also kept for [`Listener::take_collision`].
+//!
+//! Zero allocation, bounded buffers, never panics on any input or any timing (time may even
+//! go backwards: every difference saturates).
+
+use heapless::Vec;
+
+use crate::frame::{Frame, FrameDecoder, MAX_FRAME_BYTES};
+use crate::servo::{MAX_PACKET_BYTES, Packet, PacketDecoder};
+use crate::timing::{BUS_BAUD, BUS_FRAME_GAP_US, BUS_PACKET_GAP_US, ECHO_GRACE_US, wire_time_us};
+
+/// Longest transmission whose echo is tracked, in bytes: the longest servo packet or host
+/// frame. Of a longer transmission only the first this many bytes are recognised as echo.
+pub const ECHO_CAPACITY: usize = if MAX_PACKET_BYTES > MAX_FRAME_BYTES {
+    MAX_PACKET_BYTES
+} else {
+    MAX_FRAME_BYTES
+};
+
+/// Whether a station hears its own transmissions (TX and RX tied on the wire). The wiring of
+/// the myCobot's boards is not documented, so the default finds out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EchoMode {
+    /// Decide from what comes back: once a whole echo has been heard, a missing or different
+    /// one is a collision; until then a transmission that comes back silent counts as sent
+    /// (and the line as one without echo).
+    #[default]
+    Auto,
+    /// Every transmitted byte comes back; a missing or different echo is a collision.
+    Present,
+    /// Nothing transmitted comes back; any byte heard while transmitting is a collision.
+    Absent,
+}
+
+/// What a [`Listener`] decodes and when it calls a line quiet. `Default` is a station on the
+/// shared bus: host frames and servo packets, the bus gaps, echo found out.
+///
+/// Built like an esp-hal config: start from [`ListenerConfig::new`] (or `default()`) and change
+/// what differs with the `with_*` methods, which are `const`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ListenerConfig {
+    frames: bool,
+    packets: bool,
+    bytes: bool,
+    frame_gap_us: u64,
+    packet_gap_us: u64,
+    echo: EchoMode,
+}
+
+impl ListenerConfig {
+    /// A station on the shared bus: decodes host frames and servo packets, no raw bytes, frame
+    /// gap [`BUS_FRAME_GAP_US`], packet gap [`BUS_PACKET_GAP_US`], [`EchoMode::Auto`].
+    pub const fn new() -> Self {
+        Self {
+            frames: true,
+            packets: true,
+            bytes: false,
+            frame_gap_us: BUS_FRAME_GAP_US,
+            packet_gap_us: BUS_PACKET_GAP_US,
+            echo: EchoMode::Auto,
+        }
+    }
+
+    /// Whether host frames (`FE FE LEN CMD DATA FA`) are decoded ([`Heard::Frame`]).
+    pub const fn with_frames(mut self, on: bool) -> Self {
+        self.frames = on;
+        self
+    }
+
+    /// Whether servo packets with a valid checksum are decoded ([`Heard::Packet`]).
+    pub const fn with_packets(mut self, on: bool) -> Self {
+        self.packets = on;
+        self
+    }
+
+    /// Whether every received byte that is not the station's own echo is also given out as it
+    /// is ([`Heard::Byte`]), before the frames and packets it completes.
+    pub const fn with_bytes(mut self, on: bool) -> Self {
+        self.bytes = on;
+        self
+    }
+
+    /// Silence after which a partial host frame was cut short, in microseconds:
+    /// `timing::BUS_FRAME_GAP_US` on the bus, `timing::HOST_FRAME_GAP_US` on a host link.
+    pub const fn with_frame_gap_us(mut self, gap_us: u64) -> Self {
+        self.frame_gap_us = gap_us;
+        self
+    }
+
+    /// Silence after which a partial servo packet was cut short, in microseconds.
+    pub const fn with_packet_gap_us(mut self, gap_us: u64) -> Self {
+        self.packet_gap_us = gap_us;
+        self
+    }
+
+    /// Whether the station hears its own transmissions.
+    pub const fn with_echo(mut self, echo: EchoMode) -> Self {
+        self.echo = echo;
+        self
+    }
+}
+
+impl Default for ListenerConfig {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// What happened to the echo of one transmission (or of transmissions written back to back
+/// before the first one's verdict).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Echo {
+    /// Every byte came back unchanged and was dropped: the line echoes.
+    Whole,
+    /// A byte came back different, or, with [`EchoMode::Absent`], another station's byte was
+    /// heard while transmitting: a collision (or, on a line not known to echo, an answer that
+    /// began before the transmission was over). The bytes held as echo so far are released.
+    Differed,
+    /// Part of the echo came back and the rest never did, or, on a line known to echo, none of
+    /// it, within [`ECHO_GRACE_US`] of the transmission's end. What was held is released.
+    Missing,
+    /// Nothing came back and nothing had to: [`EchoMode::Absent`], or a line not known to echo
+    /// (which [`EchoMode::Auto`] now knows does not). Given once the transmission has ended and
+    /// [`ECHO_GRACE_US`] has passed since its start (an echo starts while the transmission is
+    /// still going out).
+    Silent,
+}
+
+/// What a [`Listener`] found on its line, in the order it happened.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Heard {
+    /// A complete host frame.
+    Frame(Frame),
+    /// A complete servo packet with a valid checksum.
+    Packet(Packet),
+    /// A received byte that is not the station's own echo (with
+    /// [`ListenerConfig::with_bytes`]).
+    Byte(u8),
+    /// The verdict on the station's last transmission; bytes it releases follow it.
+    Echo(Echo),
+}
+
+/// The transmission whose echo is awaited.
+#[derive(Clone, Copy, Debug)]
+struct Window {
+    /// When its first byte started on the wire, in microseconds.
+    start_us: u64,
+    /// When its last byte ends on the wire, in microseconds.
+    end_us: u64,
+}
+
+/// A station's ears on one line. See the [module doc](self).
+#[derive(Clone, Debug)]
+pub struct Listener {
+    config: ListenerConfig,
+    frames: FrameDecoder,
+    packets: PacketDecoder,
+    /// The transmission awaiting its verdict, if any.
+    window: Option<Window>,
+    /// Its bytes (as many as fit)...
+    sent: Vec<u8, ECHO_CAPACITY>,
+    /// ...and how many of them have come back so far: `sent[..echoed]` is held back.
+    echoed: usize,
+    /// When the line last carried a byte, heard or sent (the end of a transmission still going
+    /// out is in the future), in microseconds.
+    last_activity_us: u64,
+    /// What the echo has shown so far: heard whole once, or found absent ([`EchoMode::Auto`]).
+    echo_heard: Option<bool>,
+    /// A transmission differed or went missing on a line known to echo, not yet taken.
+    collided: bool,
+    /// Received bytes dropped as own echo. Wraps.
+    echo_bytes: u32,
+}
+
+impl Default for Listener {
+    fn default() -> Self {
+        Self::new(ListenerConfig::new())
+    }
+}
+
+impl Listener {
+    /// A listener that has heard nothing yet.
+    pub const fn new(config: ListenerConfig) -> Self {
+        Self {
+            config,
+            frames: FrameDecoder::new(),
+            packets: PacketDecoder::new(),
+            window: None,
+            sent: Vec::new(),
+            echoed: 0,
+            last_activity_us: 0,
+            echo_heard: None,
+            collided: false,
+            echo_bytes: 0,
+        }
+    }
+
+    /// Records that the station wrote `bytes` to the line at `now_us` (after whatever it wrote
+    /// before, if that is still going out); their echo may follow. Assumes the bus baud rate.
+    pub fn on_transmit(&mut self, now_us: u64, bytes: &[u8]) {
+        if bytes.is_empty() {
+            return;
+        }
+        let start_us = self.last_activity_us.max(now_us);
+        let len = u32::try_from(bytes.len()).unwrap_or(u32::MAX);
+        let end_us = start_us.saturating_add(wire_time_us(len, BUS_BAUD));
+        self.last_activity_us = end_us;
+        let start_us = self.window.map_or(start_us, |w| w.start_us);
+        self.window = Some(Window { start_us, end_us });
+        if self.config.echo != EchoMode::Absent {
+            let room = self.sent.capacity() - self.sent.len();
+            // Cannot fail: at most `room` bytes.
+            let _ = self
+                .sent
+                .extend_from_slice(bytes.get(..room.min(bytes.len())).unwrap_or_default());
+        }
+    }
+
+    /// Takes one byte received at `now_us`; calls `on_heard` with everything it completes or
+    /// releases, in order.
+    pub fn push(&mut self, now_us: u64, byte: u8, on_heard: &mut impl FnMut(Heard)) {
+        self.last_activity_us = self.last_activity_us.max(now_us);
+        if self.window.is_some() {
+            if self.config.echo != EchoMode::Absent && self.sent.get(self.echoed) == Some(&byte) {
+                self.echoed += 1;
+                if self.echoed >= self.sent.len() {
+                    // Cannot wrap: echoed <= ECHO_CAPACITY.
+                    self.echo_bytes = self.echo_bytes.wrapping_add(self.echoed as u32);
+                    self.sent.clear();
+                    self.echoed = 0;
+                    self.window = None;
+                    self.echo_heard = Some(true);
+                    on_heard(Heard::Echo(Echo::Whole));
+                }
+                return;
+            }
+            self.close_window(Echo::Differed, on_heard);
+        }
+        self.decode(byte, on_heard);
+    }
+
+    /// Lets time pass up to `now_us`: closes an echo window that is over and drops frames and
+    /// packets cut short by a quiet line, calling `on_heard` with what that gives out. Call it
+    /// once per poll, after the bytes received in that poll.
+    #[inline]
+    pub fn on_time(&mut self, now_us: u64, on_heard: &mut impl FnMut(Heard)) {
+        // Most polls find nothing to do: keep those to a few loads.
+        if self.window.is_some() {
+            self.judge_echo(now_us, on_heard);
+        }
+        if self.frames.has_partial() || self.packets.has_partial() {
+            self.cut_short(now_us, on_heard);
+        }
+    }
+
+    /// Forgets every frame and packet in progress, and whatever complete one a rescan would
+    /// find inside them: for a station that knows the line is quiet before it transmits (a
+    /// partial candidate must not swallow the answer), or that changes what the line means.
+    pub fn drop_partials(&mut self) {
+        let mut next = self.frames.on_quiet_line();
+        while next.is_some() {
+            next = self.frames.next_frame();
+        }
+        let mut next = self.packets.on_quiet_line();
+        while next.is_some() {
+            next = self.packets.next_packet();
+        }
+    }
+
+    /// Counts the line as busy until `now_us`, as if a byte had been heard then: at boot its
+    /// history is unknown, so it gets a quiet time first.
+    pub fn assume_busy_until(&mut self, now_us: u64) {
+        self.last_activity_us = self.last_activity_us.max(now_us);
+    }
+
+    /// True (once) if a transmission collided on a line known to echo: its echo differed or
+    /// did not come back whole.
+    pub fn take_collision(&mut self) -> bool {
+        core::mem::take(&mut self.collided)
+    }
+
+    /// True while a host frame is arriving (its start heard, its end not yet).
+    pub fn frame_in_progress(&self) -> bool {
+        self.frames.has_partial()
+    }
+
+    /// True while a transmission's echo verdict is still to come.
+    pub fn echo_pending(&self) -> bool {
+        self.window.is_some()
+    }
+
+    /// Whether the station hears its own transmissions, as far as shown so far: `Some(true)`
+    /// once a whole echo came back, `Some(false)` once a transmission came back silent with
+    /// [`EchoMode::Auto`], `None` before.
+    pub fn echo_heard(&self) -> Option<bool> {
+        self.echo_heard
+    }
+
+    /// Microseconds the line has been silent at `now_us`; 0 while the station's own
+    /// transmission is still going out.
+    pub fn quiet_us(&self, now_us: u64) -> u64 {
+        now_us.saturating_sub(self.last_activity_us)
+    }
+
+    /// Received bytes recognised as the station's own echo and dropped. Wraps.
+    pub fn echo_bytes(&self) -> u32 {
+        self.echo_bytes
+    }
+
+    /// Servo packets dropped for a bad checksum. Wraps.
+    pub fn checksum_errors(&self) -> u32 {
+        self.packets.checksum_errors()
+    }
+
+    /// Whether the echo must come back whole for a transmission to count as sent intact.
+    fn echo_required(&self) -> bool {
+        match self.config.echo {
+            EchoMode::Present => true,
+            EchoMode::Absent => false,
+            EchoMode::Auto => self.echo_heard == Some(true),
+        }
+    }
+
+    /// Gives the open transmission its verdict once its echo window is over.
+    fn judge_echo(&mut self, now_us: u64, on_heard: &mut impl FnMut(Heard)) {
+        let Some(window) = self.window else {
+            return;
+        };
+        let ended = now_us >= window.end_us;
+        let verdict = if self.config.echo == EchoMode::Absent {
+            ended.then_some(Echo::Silent)
+        } else if self.echoed == 0
+            && !self.echo_required()
+            && ended
+            && now_us >= window.start_us.saturating_add(ECHO_GRACE_US)
+        {
+            Some(Echo::Silent)
+        } else if now_us >= window.end_us.saturating_add(ECHO_GRACE_US) {
+            Some(Echo::Missing)
+        } else {
+            None
+        };
+        if let Some(verdict) = verdict {
+            self.close_window(verdict, on_heard);
+        }
+    }
+
+    /// Drops the frames and packets in progress that a quiet line has cut short.
+    fn cut_short(&mut self, now_us: u64, on_heard: &mut impl FnMut(Heard)) {
+        let quiet_us = self.quiet_us(now_us);
+        if self.config.packets
+            && quiet_us >= self.config.packet_gap_us
+            && self.packets.has_partial()
+        {
+            let mut next = self.packets.on_quiet_line();
+            while let Some(packet) = next {
+                on_heard(Heard::Packet(packet));
+                next = self.packets.next_packet();
+            }
+        }
+        if self.config.frames && quiet_us >= self.config.frame_gap_us && self.frames.has_partial() {
+            let mut next = self.frames.on_quiet_line();
+            while let Some(frame) = next {
+                on_heard(Heard::Frame(frame));
+                next = self.frames.next_frame();
+            }
+        }
+    }
+
+    /// Gives the open transmission its verdict and releases the bytes held as its echo.
+    fn close_window(&mut self, verdict: Echo, on_heard: &mut impl FnMut(Heard)) {
+        match verdict {
+            Echo::Differed | Echo::Missing if self.echo_required() => self.collided = true,
+            Echo::Silent if self.config.echo == EchoMode::Auto => self.echo_heard = Some(false),
+            _ => {}
+        }
+        self.window = None;
+        let sent = core::mem::take(&mut self.sent);
+        let held = core::mem::take(&mut self.echoed);
+        on_heard(Heard::Echo(verdict));
+        for &byte in sent.get(..held).unwrap_or_default() {
+            self.decode(byte, on_heard);
+        }
+    }
+
+    /// Passes a byte that is not own echo to the decoders that are on.
+    fn decode(&mut self, byte: u8, on_heard: &mut impl FnMut(Heard)) {
+        if self.config.bytes {
+            on_heard(Heard::Byte(byte));
+        }
+        if self.config.frames {
+            let mut next = self.frames.push(byte);
+            while let Some(frame) = next {
+                on_heard(Heard::Frame(frame));
+                next = self.frames.next_frame();
+            }
+        }
+        if self.config.packets {
+            let mut next = self.packets.push(byte);
+            while let Some(packet) = next {
+                on_heard(Heard::Packet(packet));
+                next = self.packets.next_packet();
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::servo::Instruction;
+    use crate::timing::HOST_FRAME_GAP_US;
+
+    /// Bytes arriving back to back at 1 Mbaud from `t_us`, each pushed when it ends.
+    fn run(rx: &mut Listener, t_us: u64, bytes: &[u8]) -> std::vec::Vec<Heard> {
+        let mut out = std::vec::Vec::new();
+        for (i, &b) in bytes.iter().enumerate() {
+            rx.push(t_us + 10 * i as u64, b, &mut |h| out.push(h));
+        }
+        out
+    }
+
+    fn tick(rx: &mut Listener, now_us: u64) -> std::vec::Vec<Heard> {
+        let mut out = std::vec::Vec::new();
+        rx.on_time(now_us, &mut |h| out.push(h));
+        out
+    }
+
+    fn status(id: u8, data: &[u8]) -> Packet {
+        Packet::new(id, 0, data).unwrap()
+    }
+
+    fn frame(cmd: u8, data: &[u8]) -> Frame {
+        Frame::new(cmd, data).unwrap()
+    }
+
+    fn heard_frames(heard: &[Heard]) -> std::vec::Vec<Frame> {
+        heard
+            .iter()
+            .filter_map(|h| match h {
+                Heard::Frame(f) => Some(f.clone()),
+                _ => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn own_echo_is_dropped_and_replies_are_kept() {
+        let mut rx = Listener::default();
+        let read = Instruction::Read { addr: 56, count: 2 }
+            .to_packet(1)
+            .unwrap();
+        rx.on_transmit(0, &read.to_bytes());
+        assert_eq!(
+            run(&mut rx, 10, &read.to_bytes()),
+            [Heard::Echo(Echo::Whole)]
+        );
+        let reply = status(1, &[0x00, 0x08]);
+        assert_eq!(run(&mut rx, 200, &reply.to_bytes()), [Heard::Packet(reply)]);
+        assert_eq!(rx.echo_bytes(), 8);
+        assert_eq!(rx.echo_heard(), Some(true));
+    }
+
+    #[test]
+    fn line_without_echo_still_delivers_replies() {
+        let mut rx = Listener::default();
+        let ping = Instruction::Ping.to_packet(1).unwrap();
+        rx.on_transmit(0, &ping.to_bytes());
+        // The reply shares the first bytes with the instruction (FF FF 01 02): they are held,
+        // then released at the first difference.
+        let reply = status(1, &[]);
+        assert_eq!(
+            run(&mut rx, 70, &reply.to_bytes()),
+            [Heard::Echo(Echo::Differed), Heard::Packet(reply.clone())]
+        );
+        // After the echo window, nothing is held at all.
+        rx.on_transmit(1000, &ping.to_bytes());
+        assert_eq!(tick(&mut rx, 1200), [Heard::Echo(Echo::Silent)]);
+        assert_eq!(rx.echo_heard(), Some(false));
+        assert_eq!(
+            run(&mut rx, 1200, &reply.to_bytes()),
+            [Heard::Packet(reply)]
+        );
+        assert!(
+            !rx.take_collision(),
+            "nothing to collide with on a silent line"
+        );
+    }
+
+    #[test]
+    fn own_reply_frame_is_not_taken_for_a_request() {
+        let mut rx = Listener::default();
+        let reply = frame(0x1A, &[1]);
+        rx.on_transmit(0, &reply.to_bytes());
+        assert!(heard_frames(&run(&mut rx, 0, &reply.to_bytes())).is_empty());
+        let request = frame(0x20, &[]);
+        assert_eq!(
+            run(&mut rx, 500, &request.to_bytes()),
+            [Heard::Frame(request)]
+        );
+    }
+
+    #[test]
+    fn collision_is_reported_on_a_line_that_echoes() {
+        let mut rx = Listener::default();
+        let reply = frame(0x20, &[0; 12]).to_bytes();
+        rx.on_transmit(0, &reply);
+        run(&mut rx, 10, &reply);
+        assert!(!rx.take_collision());
+        rx.on_transmit(1000, &reply);
+        let mut garbled = reply.clone();
+        garbled[6] ^= 0x10;
+        let heard = run(&mut rx, 1010, &garbled);
+        assert_eq!(heard.first(), Some(&Heard::Echo(Echo::Differed)));
+        assert!(rx.take_collision());
+        assert!(!rx.take_collision(), "reported once");
+    }
+
+    #[test]
+    fn an_echo_that_stops_halfway_is_missing_once_the_grace_is_over() {
+        let mut rx = Listener::default();
+        let request = frame(0x20, &[]).to_bytes();
+        rx.on_transmit(0, &request);
+        run(&mut rx, 10, &request);
+        rx.on_transmit(1000, &request);
+        run(&mut rx, 1010, &request[..2]);
+        let end_us = 1000 + 10 * request.len() as u64;
+        assert!(tick(&mut rx, end_us + ECHO_GRACE_US - 1).is_empty());
+        assert_eq!(
+            tick(&mut rx, end_us + ECHO_GRACE_US),
+            [Heard::Echo(Echo::Missing)]
+        );
+        assert!(rx.take_collision());
+        assert!(rx.frame_in_progress(), "the held FE FE were released");
+    }
+
+    #[test]
+    fn on_a_line_known_to_echo_silence_is_a_missing_echo() {
+        let mut rx = Listener::new(ListenerConfig::new().with_echo(EchoMode::Present));
+        rx.on_transmit(0, &[1, 2, 3, 4, 5]);
+        assert!(tick(&mut rx, 50).is_empty(), "no verdict at the end yet");
+        assert_eq!(tick(&mut rx, 80), [Heard::Echo(Echo::Missing)]);
+        assert!(rx.take_collision());
+    }
+
+    #[test]
+    fn silence_is_judged_at_the_end_of_the_transmission() {
+        let mut rx = Listener::default();
+        let request = frame(0x22, &[0; 13]).to_bytes();
+        rx.on_transmit(100, &request);
+        assert_eq!(rx.quiet_us(150), 0, "still transmitting");
+        let end_us = 100 + 10 * request.len() as u64;
+        assert!(tick(&mut rx, end_us - 1).is_empty());
+        assert_eq!(tick(&mut rx, end_us), [Heard::Echo(Echo::Silent)]);
+        // A single byte's echo may still be on its way at its end: it gets the grace.
+        rx.on_transmit(1000, &[0x55]);
+        assert!(tick(&mut rx, 1010).is_empty());
+        assert_eq!(
+            run(&mut rx, 1025, &[0x55]),
+            [Heard::Echo(Echo::Whole)],
+            "a late echo of one byte is still recognised"
+        );
+    }
+
+    #[test]
+    fn without_echo_any_byte_while_transmitting_is_a_collision() {
+        let config = ListenerConfig::new()
+            .with_echo(EchoMode::Absent)
+            .with_bytes(true);
+        let mut rx = Listener::new(config);
+        rx.on_transmit(0, &[0xFE, 0xFE, 0x02, 0x20, 0xFA]);
+        assert_eq!(
+            run(&mut rx, 20, &[0xFE]),
+            [Heard::Echo(Echo::Differed), Heard::Byte(0xFE)],
+            "not held: it cannot be an echo"
+        );
+        rx.on_transmit(100, &[0xFE, 0xFE, 0x02, 0x20, 0xFA]);
+        assert_eq!(tick(&mut rx, 150), [Heard::Echo(Echo::Silent)]);
+        assert_eq!(rx.echo_heard(), None, "fixed by the config, not learned");
+        assert!(!rx.take_collision());
+    }
+
+    #[test]
+    fn raw_bytes_come_out_without_the_echo_and_in_order() {
+        let mut rx = Listener::new(ListenerConfig::new().with_bytes(true));
+        rx.on_transmit(0, &[1, 2, 3]);
+        assert_eq!(
+            run(&mut rx, 10, &[1, 2, 3, 4]),
+            [Heard::Echo(Echo::Whole), Heard::Byte(4)]
+        );
+        rx.on_transmit(100, &[1, 2, 3]);
+        assert_eq!(
+            run(&mut rx, 110, &[1, 2, 9]),
+            [
+                Heard::Echo(Echo::Differed),
+                Heard::Byte(1),
+                Heard::Byte(2),
+                Heard::Byte(9)
+            ]
+        );
+    }
+
+    #[test]
+    fn truncated_frame_is_dropped_after_a_quiet_gap() {
+        let mut rx = Listener::default();
+        assert!(run(&mut rx, 0, &[0xFE, 0xFE, 0x0F, 0x22]).is_empty());
+        assert!(rx.frame_in_progress());
+        tick(&mut rx, 30 + BUS_FRAME_GAP_US - 1);
+        assert!(rx.frame_in_progress());
+        tick(&mut rx, 30 + BUS_FRAME_GAP_US);
+        assert!(!rx.frame_in_progress());
+        let request = frame(0x20, &[]);
+        assert_eq!(
+            run(&mut rx, 1000, &request.to_bytes()),
+            [Heard::Frame(request)]
+        );
+    }
+
+    #[test]
+    fn a_late_read_is_not_a_silence_inside_a_frame() {
+        // A station busy for longer than the gap reads the rest of a frame late, stamped with
+        // its poll time: the frame still completes.
+        let mut rx = Listener::default();
+        let request = frame(0x20, &[]).to_bytes();
+        run(&mut rx, 0, &request[..2]);
+        tick(&mut rx, 10);
+        let heard = run(&mut rx, 10 + 5 * BUS_FRAME_GAP_US, &request[2..]);
+        assert_eq!(heard, [Heard::Frame(frame(0x20, &[]))]);
+    }
+
+    #[test]
+    fn a_cut_packet_is_dropped_after_the_packet_gap_and_the_next_one_kept() {
+        let mut rx = Listener::default();
+        let ping = Instruction::Ping.to_packet(1).unwrap().to_bytes();
+        run(&mut rx, 0, &ping[..4]);
+        assert!(tick(&mut rx, 30 + BUS_PACKET_GAP_US - 1).is_empty());
+        tick(&mut rx, 30 + BUS_PACKET_GAP_US);
+        let reply = status(1, &[]);
+        assert_eq!(run(&mut rx, 500, &reply.to_bytes()), [Heard::Packet(reply)]);
+    }
+
+    #[test]
+    fn a_host_link_waits_its_own_gap_and_decodes_frames_only() {
+        let config = ListenerConfig::new()
+            .with_packets(false)
+            .with_frame_gap_us(HOST_FRAME_GAP_US);
+        let mut rx = Listener::new(config);
+        let ping = Instruction::Ping.to_packet(1).unwrap().to_bytes();
+        assert!(run(&mut rx, 0, &ping).is_empty(), "no servo packets");
+        run(&mut rx, 100, &[0xFE, 0xFE, 0x03]);
+        tick(&mut rx, 120 + BUS_FRAME_GAP_US);
+        assert!(rx.frame_in_progress(), "the bus gap is not the host's");
+        tick(&mut rx, 120 + HOST_FRAME_GAP_US);
+        assert!(!rx.frame_in_progress());
+    }
+
+    #[test]
+    fn dropped_partials_do_not_swallow_the_answer() {
+        let mut rx = Listener::default();
+        // A false start with a large LEN would hold the next 48 bytes.
+        run(&mut rx, 0, &[0xFE, 0xFE, 0x30]);
+        rx.drop_partials();
+        let reply = frame(0x20, &[1]);
+        assert_eq!(run(&mut rx, 100, &reply.to_bytes()), [Heard::Frame(reply)]);
+    }
+
+    #[test]
+    fn the_line_is_busy_until_the_own_transmission_ends() {
+        let mut rx = Listener::default();
+        rx.assume_busy_until(1_000);
+        assert_eq!(rx.quiet_us(1_060), 60);
+        rx.on_transmit(1_100, &[0; 5]);
+        assert_eq!(rx.quiet_us(1_140), 0);
+        assert_eq!(rx.quiet_us(1_170), 20);
+        assert_eq!(tick(&mut rx, 1_170), [Heard::Echo(Echo::Silent)]);
+        // Written while the first is still going out: queued behind it, one verdict for both.
+        rx.on_transmit(1_200, &[1]);
+        rx.on_transmit(1_200, &[2]);
+        assert_eq!(rx.quiet_us(1_220), 0);
+        assert_eq!(run(&mut rx, 1_210, &[1, 2]), [Heard::Echo(Echo::Whole)]);
+    }
+
+    #[test]
+    fn any_time_and_any_bytes_never_panic() {
+        let mut rx = Listener::new(ListenerConfig::new().with_bytes(true));
+        rx.on_transmit(u64::MAX - 3, &[0xFF; 300]);
+        for t in [u64::MAX, 0, 5, u64::MAX - 1] {
+            rx.push(t, 0xFF, &mut |_| {});
+            rx.on_time(t, &mut |_| {});
+        }
+        rx.on_transmit(0, &[]);
+        assert_eq!(rx.quiet_us(0), 0);
+    }
+}
