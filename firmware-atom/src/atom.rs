@@ -14,7 +14,6 @@ use protocol_core::units::{Centideg, Steps};
 use protocol_core::{BytePort, Frame};
 
 use crate::bank::ServoBank;
-use crate::bus::BusEvent;
 use crate::config::{AtomConfig, ConfigError, GRIPPER, JOINTS, JointLimit};
 use crate::error::ErrorLog;
 use crate::gripper::Gripper;
@@ -22,7 +21,7 @@ use crate::health::ServoHealth;
 use crate::io::AtomIo;
 use crate::link::{Link, READ_BUDGET, UsbLink};
 use crate::motion::MotionController;
-use crate::schedule::BusSchedule;
+use crate::schedule::{BusEvent, BusSchedule};
 use crate::settings::Settings;
 
 /// The parts a command acts on.
@@ -142,7 +141,8 @@ impl Atom {
                 usb.write(&reply.to_bytes());
             }
         };
-        let mut frames: heapless::Vec<Frame, 16> = heapless::Vec::new();
+        let mut frames: heapless::Vec<Frame, { crate::schedule::MAX_FRAMES_AT_ONCE }> =
+            heapless::Vec::new();
         for _ in 0..READ_BUDGET {
             let Some(byte) = usb.read_byte() else { break };
             self.usb.push(now_us, byte, &mut |f| {

@@ -11,7 +11,7 @@ use protocol_core::BytePort;
 use protocol_core::servo::{BROADCAST_ID, Instruction, Packet};
 use protocol_core::timing::{BUS_BAUD, SERVO_TURNAROUND_MAX_US, wire_time_us};
 
-use crate::bus::BusReceiver;
+use protocol_core::listener::Listener;
 
 /// Most data bytes one WRITE carries: the 7-byte move block is the largest the Atom writes.
 pub const MAX_WRITE: usize = 8;
@@ -141,7 +141,7 @@ impl ServoDriver {
         now_us: u64,
         op: Op,
         bus: &mut B,
-        rx: &mut BusReceiver,
+        rx: &mut Listener,
     ) -> bool {
         if self.busy() {
             return false;
@@ -206,7 +206,7 @@ mod tests {
     use protocol_core::NullPort;
 
     fn start(driver: &mut ServoDriver, op: Op) {
-        let mut rx = BusReceiver::new();
+        let mut rx = Listener::default();
         assert!(driver.start(0, op, &mut NullPort, &mut rx));
     }
 
@@ -229,7 +229,7 @@ mod tests {
             0,
             Op::Ping { id: 1 },
             &mut NullPort,
-            &mut BusReceiver::new()
+            &mut Listener::default()
         ));
         assert_eq!(d.on_packet(status(4, &[0, 8])), None, "another servo");
         assert_eq!(d.on_packet(status(3, &[0])), None, "short answer");

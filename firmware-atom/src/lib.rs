@@ -51,7 +51,6 @@
 
 mod atom;
 mod bank;
-pub mod bus;
 pub mod cartesian;
 mod commands;
 pub mod config;

@@ -13,13 +13,14 @@
 //! never repeats an incremental jog); a frame equal to our last reply heard just after it is our
 //! own echo, not a request.
 
+use protocol_core::listener::{Heard, Listener};
+use protocol_core::servo::Packet;
 use protocol_core::timing::{
     ATOM_TRANSACTION_GAP_US, BUS_BAUD, BUS_QUIET_BEFORE_SEND_US, wire_time_us,
 };
 use protocol_core::{BytePort, Frame};
 
 use crate::bank::ServoBank;
-use crate::bus::{BusEvent, BusReceiver};
 use crate::driver::{Op, Outcome, ServoDriver};
 use crate::settings::Settings;
 
@@ -32,14 +33,41 @@ const OWN_REPLY_WINDOW_US: u64 = 300;
 /// own resend takes over.
 pub const REPLY_RESENDS: u8 = 2;
 
-/// Events found in one received byte or one passage of time (a byte can complete a frame and
-/// a packet at once; a quiet line can flush both decoders).
-pub type BusEvents = heapless::Vec<BusEvent, 4>;
+/// What the Atom hears on the bus.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum BusEvent {
+    /// A host frame (a request from the Basic).
+    Frame(Frame),
+    /// A servo packet with a valid checksum (a status reply).
+    Packet(Packet),
+}
+
+/// Events found in one received byte or one passage of time: a byte can complete a packet and
+/// up to [`MAX_FRAMES_AT_ONCE`] frames uncovered by a rescan.
+pub type BusEvents = heapless::Vec<BusEvent, { MAX_FRAMES_AT_ONCE + 1 }>;
+
+/// Most frames one byte (or one quiet gap) can complete: the framer holds at most
+/// `MAX_FRAME_BYTES` bytes, and a frame takes at least `3 + MIN_LEN` of them.
+pub const MAX_FRAMES_AT_ONCE: usize =
+    protocol_core::frame::MAX_FRAME_BYTES / (3 + protocol_core::frame::MIN_LEN as usize);
+
+/// Keeps what the Atom acts on of what the listener heard.
+fn collect(events: &mut BusEvents) -> impl FnMut(Heard) + '_ {
+    |heard| {
+        let event = match heard {
+            Heard::Frame(f) => BusEvent::Frame(f),
+            Heard::Packet(p) => BusEvent::Packet(p),
+            // Echo verdicts: the collision flag covers what the schedule needs.
+            Heard::Byte(_) | Heard::Echo(_) => return,
+        };
+        let _ = events.push(event);
+    }
+}
 
 /// The schedule of the shared bus. See the [module doc](self).
 #[derive(Clone, Debug)]
 pub struct BusSchedule {
-    rx: BusReceiver,
+    rx: Listener,
     driver: ServoDriver,
     /// A refresh read is owed after a non-refresh transaction.
     owe_refresh: bool,
@@ -62,7 +90,7 @@ impl BusSchedule {
     /// A schedule allowing `reply_margin_us` beyond the computed time of each servo answer.
     pub fn new(reply_margin_us: u64) -> Self {
         Self {
-            rx: BusReceiver::new(),
+            rx: Listener::default(),
             driver: ServoDriver::new(reply_margin_us),
             owe_refresh: false,
             checksum_errors_at_start: 0,
@@ -78,9 +106,7 @@ impl BusSchedule {
     /// completes (our own reply's echo left out).
     pub fn hear(&mut self, now_us: u64, byte: u8) -> BusEvents {
         let mut events = BusEvents::new();
-        self.rx.push(now_us, byte, &mut |e| {
-            let _ = events.push(e);
-        });
+        self.rx.push(now_us, byte, &mut collect(&mut events));
         self.drop_own_reply(now_us, events)
     }
 
@@ -88,9 +114,7 @@ impl BusSchedule {
     /// that collided (queued again). Call once per poll after the received bytes.
     pub fn on_time(&mut self, now_us: u64) -> BusEvents {
         let mut events = BusEvents::new();
-        self.rx.on_time(now_us, &mut |e| {
-            let _ = events.push(e);
-        });
+        self.rx.on_time(now_us, &mut collect(&mut events));
         if self.rx.take_collision()
             && self.reply_on_wire
             && self.reply_resends > 0
@@ -122,7 +146,7 @@ impl BusSchedule {
 
     /// Offers a received servo packet to the transaction in flight; returns the transaction
     /// it finished.
-    pub fn on_packet(&mut self, packet: protocol_core::servo::Packet) -> Option<(Op, Outcome)> {
+    pub fn on_packet(&mut self, packet: Packet) -> Option<(Op, Outcome)> {
         self.driver.on_packet(packet)
     }
 
