@@ -116,8 +116,19 @@ fn execute<I: AtomIo>(
             done()
         }
         R::PowerOn => {
-            let ok = bank.power(settings, true);
             settings.set_free_mode(false);
+            if bank.powered() {
+                // Already on (the Basic says so at its boot): a running move goes on; only
+                // a servo released since gets its torque back.
+                let mut ok = true;
+                for i in 0..SERVOS {
+                    if !bank.enabled(i) {
+                        ok &= bank.set_torque(settings, i, true);
+                    }
+                }
+                return done_if(ok);
+            }
+            let ok = bank.power(settings, true);
             // Hold where the arm is now instead of jumping to an old goal.
             motion.stop(now_us, bank, settings);
             done_if(ok)

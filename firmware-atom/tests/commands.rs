@@ -750,3 +750,18 @@ fn is_in_position_waits_for_the_arm_to_come_to_rest() {
     }
     panic!("never in position");
 }
+
+#[test]
+fn power_on_while_powered_does_not_cut_a_move_short() {
+    // The Basic sends power on (0x10) at its boot, which may come after a client's first move.
+    let mut rig = Rig::new();
+    let target = [9000i16, 0, 0, 0, 0, 0];
+    let mut data = be(&target);
+    data.push(100);
+    assert_eq!(rig.ask(SEND_ANGLES, &data), [1]);
+    rig.run_ms(200);
+    assert_eq!(rig.ask(0x10, &[]), [1]);
+    rig.run_ms(3000);
+    let end = angles(&mut rig);
+    assert!(close(&end, &target, 10), "{end:?}");
+}
