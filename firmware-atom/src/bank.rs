@@ -149,10 +149,17 @@ impl ServoBank {
         core::array::from_fn(|j| self.health.get(j).map(|h| h.position).unwrap_or_default())
     }
 
-    /// Present joint angles, from the servos' last reported positions.
+    /// Present joint angles: each joint's last read position moved on by its last read speed
+    /// for the time since ([`Self::estimated_millisteps`]). At rest that is exactly the
+    /// servo's reading; while moving it is where the joint is now rather than where it was at
+    /// its read (the seven reads of a round are up to 4 ms apart, which would skew a pose read
+    /// during a fast move).
     pub fn present_angles(&self, settings: &Settings) -> [Centideg; JOINTS] {
-        let steps = self.present_steps();
-        core::array::from_fn(|j| settings.angle(j, steps.get(j).copied().unwrap_or_default()))
+        core::array::from_fn(|j| {
+            settings
+                .config()
+                .millisteps_to_angle(j, self.estimated_millisteps(j))
+        })
     }
 
     /// Joint `j`'s last read speed, steps per second (0 if it does not answer or holds no

@@ -256,6 +256,19 @@ impl AtomConfig {
             .clamp(1, 254) as u8
     }
 
+    /// Joint angle of encoder position `millisteps` (thousandths of a step) of joint `joint`,
+    /// rounded to the nearest centidegree within +-180 degrees.
+    pub fn millisteps_to_angle(&self, joint: usize, millisteps: i64) -> Centideg {
+        let delta = millisteps - i64::from(STEPS_ZERO) * 1000;
+        let scale = i64::from(STEPS_PER_TURN) * 1000;
+        let centideg = (delta * 36_000 + delta.signum() * scale / 2) / scale;
+        let signed = match self.joint_signs.get(joint) {
+            Some(JointSign::Negative) => -centideg,
+            _ => centideg,
+        };
+        Centideg(signed.clamp(-18_000, 18_000) as i16)
+    }
+
     /// Encoder position of joint `joint` at `centideg`, in thousandths of a step (unrounded,
     /// not limited to one turn).
     pub fn angle_to_millisteps(&self, joint: usize, centideg: i32) -> i64 {
