@@ -234,6 +234,74 @@ fn streams() {
     }
 }
 
+/// A send_coords stream: the flange drawing a 40 mm circle at 0.25 Hz, 50 samples a second.
+fn coords_stream() {
+    let mut robot = booted();
+    move_to(&mut robot, [10.0, -30.0, -50.0, -10.0, 10.0, 20.0]);
+    let Reply::Coords(centre) = ask(&mut robot, Request::GetCoords) else {
+        panic!("get_coords")
+    };
+    let circle = |t: f64| -> [f64; 3] {
+        let a = TAU * 0.25 * t;
+        [
+            f64::from(centre.x.0) / 10.0 + 40.0 * (a.cos() - 1.0),
+            f64::from(centre.y.0) / 10.0 + 40.0 * a.sin(),
+            f64::from(centre.z.0) / 10.0,
+        ]
+    };
+    let period_us = 20_000;
+    let start_us = robot.now_us();
+    let mut next_sample_us = start_us;
+    let mut trace: Vec<(f64, [f64; 3])> = Vec::new();
+    while robot.now_us() < start_us + 6_000_000 {
+        if robot.now_us() >= next_sample_us {
+            let p = circle((robot.now_us() - start_us) as f64 / 1e6);
+            let pose = Pose {
+                x: DeciMm((p[0] * 10.0).round() as i16),
+                y: DeciMm((p[1] * 10.0).round() as i16),
+                z: DeciMm((p[2] * 10.0).round() as i16),
+                ..centre
+            };
+            send(
+                &mut robot,
+                &Request::SendCoords {
+                    pose,
+                    speed: speed(100),
+                    mode: Some(MoveMode::Joint),
+                },
+            );
+            next_sample_us += period_us;
+        }
+        robot.run_for(SAMPLE_US);
+        drain(&mut robot);
+        let t = (robot.now_us() - start_us) as f64 / 1e6;
+        trace.push((t, measure::flange(&robot.shaft_angles_deg()).position_mm));
+    }
+    let steady: Vec<&(f64, [f64; 3])> = trace.iter().filter(|(t, _)| *t >= 1.0).collect();
+    let fit = |lag_s: f64| -> (f64, f64) {
+        let (mut sum, mut worst) = (0.0, 0.0f64);
+        for (t, p) in &steady {
+            let e = measure::distance_to_segment_mm(p, &circle(t - lag_s), &circle(t - lag_s));
+            sum += e * e;
+            worst = worst.max(e);
+        }
+        ((sum / steady.len() as f64).sqrt(), worst)
+    };
+    let best_lag_ms = (0..=200)
+        .min_by(|&a, &b| {
+            fit(f64::from(a) / 1e3)
+                .0
+                .total_cmp(&fit(f64::from(b) / 1e3).0)
+        })
+        .unwrap_or(0);
+    let (rms, worst) = fit(f64::from(best_lag_ms) / 1e3);
+    println!(
+        " 50 Hz send_coords (40 mm circle at 0.25 Hz): lag {best_lag_ms} ms = period + {} ms, \
+         residual {rms:.3} mm RMS, worst {worst:.2} mm",
+        best_lag_ms as i64 - 20
+    );
+}
+
 /// The flange's largest distance from the segment `a`..`b` and turn from `orientation` over
 /// `trace`.
 fn deviation(trace: &[FlangePose], a: &[f64; 3], b: &[f64; 3], start: &FlangePose) -> (f64, f64) {
@@ -347,6 +415,7 @@ fn main() {
     }
     if want("stream") {
         streams();
+        coords_stream();
     }
     if want("line") {
         lines();
