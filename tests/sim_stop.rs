@@ -133,3 +133,48 @@ fn stopping_a_rotation_jog_keeps_the_flange_where_it_was() {
         );
     }
 }
+
+#[test]
+fn a_new_move_that_reverses_a_fast_jog_brakes_at_the_servos_limit_first() {
+    let mut robot = arm();
+    ack(
+        &mut robot,
+        Request::SendAngles {
+            angles: degrees([-120.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            speed: speed(100),
+        },
+    );
+    wait_until_stopped(&mut robot);
+    ack(
+        &mut robot,
+        Request::JogAngle {
+            joint: JointId::new(1).expect("joint 1"),
+            direction: Direction::Positive,
+            speed: speed(100),
+        },
+    );
+    robot.run_for(1_200_000);
+    let at_command = robot.measured_angles()[0];
+    ack(
+        &mut robot,
+        Request::SendAngles {
+            angles: degrees([-100.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            speed: speed(100),
+        },
+    );
+    let trace = joint1_trace(&mut robot, 300_000);
+    let furthest = trace.iter().copied().max().unwrap_or(at_command.0);
+    // 150 deg/s braked at 1000 deg/s^2 (docs/motion.md): 11.25 deg, not the 56 deg of the
+    // gentle ramp a planned move uses.
+    assert!(
+        furthest - at_command.0 <= 1_250,
+        "joint 1 coasted from {} to {furthest} centideg before turning back",
+        at_command.0
+    );
+    wait_until_stopped(&mut robot);
+    assert_angles_near(
+        robot.measured_angles(),
+        degrees([-100.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        "the new move arrives",
+    );
+}
