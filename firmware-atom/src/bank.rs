@@ -78,6 +78,8 @@ pub struct Completion {
 pub struct ServoBank {
     /// True while the arm is powered on (torque enabled by 0x10, until 0x11).
     powered: bool,
+    /// Whether the Atom has told each servo anything (torque, a goal) since it started.
+    commanded: [bool; SERVOS],
     health: [ServoHealth; SERVOS],
     /// When each servo's state was last read.
     read_us: [u64; SERVOS],
@@ -106,6 +108,7 @@ impl ServoBank {
         }
         Self {
             powered,
+            commanded: [false; SERVOS],
             health,
             read_us: [0; SERVOS],
             last_goal: [None; SERVOS],
@@ -236,6 +239,9 @@ impl ServoBank {
         for (i, (slot, new)) in merged.iter_mut().zip(safe.goals()).enumerate() {
             if let Some(g) = new {
                 *slot = Some(*g);
+                if let Some(c) = self.commanded.get_mut(i) {
+                    *c = true;
+                }
                 if let Some(last) = self.last_goal.get_mut(i) {
                     *last = Some(*g);
                 }
@@ -283,6 +289,9 @@ impl ServoBank {
             Op::write(id, reg::TORQUE_ENABLE, &[0])
                 .is_some_and(|op| self.queue_op(op, Then::Nothing))
         };
+        if let Some(c) = self.commanded.get_mut(index) {
+            *c = true;
+        }
         if queued && let Some(h) = self.health.get_mut(index) {
             h.torque_on = on;
             if let Some(r) = self.repairs.get_mut(index) {
@@ -424,9 +433,13 @@ impl ServoBank {
             let h = self.health.get_mut(i)?;
             match &outcome {
                 Outcome::Answered(p) => {
+                    let first = !h.ever_answered;
                     apply_state(h, p);
                     if let Some(t) = self.read_us.get_mut(i) {
                         *t = self.now_us;
+                    }
+                    if first {
+                        self.adopt(i, p);
                     }
                     self.verify(settings, i);
                 }
@@ -475,6 +488,38 @@ impl ServoBank {
             Frame::new(cmd::GET_SERVO_DATA, &[value as u8])
         }?;
         Some(Completion { link, reply })
+    }
+
+    /// Takes over what servo `index` is doing when the Atom hears it for the first time and
+    /// has not told it anything yet: a servo that holds torque keeps its goal (the Atom
+    /// restarted while the arm was on: the arm stays powered, a move in progress finishes,
+    /// nothing goes limp or stops), a released one stays released.
+    fn adopt(&mut self, index: usize, packet: &protocol_core::servo::Packet) {
+        if self.commanded.get(index).copied().unwrap_or(true) {
+            return;
+        }
+        let Some(h) = self.health.get_mut(index) else {
+            return;
+        };
+        if !h.torque_reported {
+            return;
+        }
+        h.torque_on = true;
+        self.powered = true;
+        let at = |addr: u8| usize::from(addr - STATE_READ_ADDR);
+        let speed = packet.u16_at(at(reg::GOAL_SPEED)).unwrap_or(0) & 0x7FFF;
+        let accel = packet
+            .params()
+            .get(at(reg::ACCELERATION))
+            .copied()
+            .unwrap_or(0);
+        if let Some(goal) = self.last_goal.get_mut(index) {
+            *goal = Some(Goal {
+                position: h.goal_reported,
+                speed_steps_per_s: speed.max(1),
+                accel: accel.max(1),
+            });
+        }
     }
 
     /// The gripper's present position.

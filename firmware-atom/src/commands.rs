@@ -214,12 +214,10 @@ fn execute<I: AtomIo>(
             byte(near && !is_moving(p))
         }
         R::IsMoving => byte(is_moving(p)),
+        // No solution: `00` (pymycobot then returns 0, never a list of angles) and error 32.
         R::SolveIk { target, current } => match settings.cart().inverse(&target, &current) {
             Ok(q) => Answer::Now(Reply::Angles(q)),
-            Err(e) => {
-                errors.record(e.into());
-                Answer::Now(Reply::Angles(current))
-            }
+            Err(e) => Answer::Done(Err(e.into())),
         },
         R::GetAnglesCoords => {
             let angles = bank.present_angles(settings);
@@ -435,7 +433,11 @@ fn execute<I: AtomIo>(
             pin,
             frequency_hz,
             duty,
-        } => done_if(is_output_pin(pin.gpio()) && io.set_pwm(pin.gpio(), frequency_hz, duty)),
+        } => done_if(
+            frequency_hz > 0
+                && is_output_pin(pin.gpio())
+                && io.set_pwm(pin.gpio(), frequency_hz, duty),
+        ),
         R::GetGripperValue { .. } => Answer::Now(Reply::Byte(gripper.value(bank))),
         R::SetGripperStateNoSpeed { state } => {
             Answer::Done(gripper.set_state(bank, settings, state, 50))

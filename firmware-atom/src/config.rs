@@ -48,9 +48,12 @@ impl JointLimit {
     }
 }
 
-/// Joint limits of the current vendor firmware (`kinematics.md`): J1 +-168, J2 +-140,
-/// J3 +-150, J4 +-150, J5 -155..+160, J6 +-180 degrees.
-pub const DEFAULT_LIMITS: [JointLimit; JOINTS] = [
+/// The factory joint range of the myCobot 280 M5, degrees: J1 +-168, J2 +-140, J3 +-150,
+/// J4 +-150, J5 -155..+160, J6 +-180. Source: the current vendor firmware as documented in
+/// `kinematics.md`, and pymycobot 4.0.7's own table for `MyCobot280` (`robot_info.py`,
+/// `angles_min` / `angles_max`). A hard outer bound: the limits may be narrowed at run time
+/// (0x4C/0x4D), never widened beyond it.
+pub const FACTORY_LIMITS: [JointLimit; JOINTS] = [
     JointLimit::degrees(-168, 168),
     JointLimit::degrees(-140, 140),
     JointLimit::degrees(-150, 150),
@@ -58,6 +61,9 @@ pub const DEFAULT_LIMITS: [JointLimit; JOINTS] = [
     JointLimit::degrees(-155, 160),
     JointLimit::degrees(-180, 180),
 ];
+
+/// The joint limits at boot: the factory range.
+pub const DEFAULT_LIMITS: [JointLimit; JOINTS] = FACTORY_LIMITS;
 
 /// Speeds and accelerations at 100 % (`kinematics.md`: joints up to 150 deg/s and 200 deg/s^2,
 /// Cartesian up to 100 mm/s), and what the servos can do.
@@ -156,7 +162,7 @@ impl Default for TimingBudget {
 pub enum ConfigError {
     /// A servo id is outside 0..=0xFC or used twice.
     BadServoId,
-    /// A joint limit has min > max or exceeds +-180 degrees.
+    /// A joint limit has min > max or lies outside the factory range ([`FACTORY_LIMITS`]).
     BadJointLimit,
     /// The gripper range is empty or outside 0..4095.
     BadGripperRange,
@@ -172,7 +178,7 @@ pub struct AtomConfig {
     pub servo_ids: [u8; SERVOS],
     /// Direction of each joint: the one place that says whether +steps is +degrees.
     pub joint_signs: [JointSign; JOINTS],
-    /// Joint limits at boot (settable at run time with 0x4C/0x4D).
+    /// Joint limits at boot (narrowed at run time with 0x4C/0x4D), within [`FACTORY_LIMITS`].
     pub joint_limits: [JointLimit; JOINTS],
     /// Speeds at 100 %.
     pub motion: MotionLimits,
@@ -211,7 +217,8 @@ impl AtomConfig {
         if self
             .joint_limits
             .iter()
-            .any(|l| l.min > l.max || l.min.0 < -18_000 || l.max.0 > 18_000)
+            .zip(&FACTORY_LIMITS)
+            .any(|(l, f)| l.min > l.max || l.min < f.min || l.max > f.max)
         {
             return Err(ConfigError::BadJointLimit);
         }

@@ -1,10 +1,26 @@
 //! Host access to single servos: raw register reads and writes (0x52/0x53), calibration
 //! (0x54, 0x68), joint brake (0x55) and drag goals (0x3E).
 //!
-//! A raw write may not bypass the firmware's bookkeeping: a write touching the goal position is
-//! a motion and goes through the safety check; torque writes go through the torque bookkeeping
-//! (torque 128 is the calibration); id and baud rate are refused (they would take the servo off
-//! the arm's bus). EEPROM registers are unlocked and locked around the write.
+//! # Register policy of raw writes (0x52)
+//!
+//! A raw write may neither bypass the firmware's bookkeeping nor change what a position means
+//! or switch a protection off ([`access`]):
+//!
+//! | registers | write |
+//! |---|---|
+//! | 21..=23 PID, 24..=25 minimum start-up force, 26..=27 dead zones, 37 / 39 speed loop gains | tuning: written, EEPROM unlocked and locked around it |
+//! | 41 acceleration, 44..=45 goal time, 46..=47 goal speed, 48..=49 torque limit | written |
+//! | 40 torque enable | through the torque bookkeeping (128 is the calibration, as 0x54) |
+//! | 42..=43 goal position (a two-byte write at 42) | a motion: through the safety check |
+//! | 5 id, 6 baud rate | refused: the servo would leave the arm's bus |
+//! | 7 return delay, 8 status return level | refused: the bus schedule relies on both |
+//! | 9..=12 angle limits, 30 angle resolution, 31..=32 homing offset, 33 operating mode | refused: they change what a position means (the joint's zero moves only by calibration) |
+//! | 13..=20 temperature, voltage, torque limits, unloading and alarm conditions, 28..=29, 34..=36, 38 protection settings | refused: protections stay on |
+//! | 55 EEPROM lock | refused: the firmware opens and closes it |
+//! | 0..=4 and 56.. (read-only), anything else | refused |
+//!
+//! A write that touches a refused register (a two-byte write starting one below it) is refused
+//! as a whole, answered `00`, and changes nothing.
 
 use protocol_core::command::ServoValue;
 use protocol_core::servo::{reg, sign_magnitude};
@@ -22,6 +38,29 @@ use crate::settings::Settings;
 
 /// Servo registers below this address are EEPROM: writes need the lock (55) opened first.
 const FIRST_RAM_REGISTER: u8 = reg::TORQUE_ENABLE;
+
+/// What a raw write (0x52) may do to one servo register (the [module doc](self)'s table).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Access {
+    /// Tuning or RAM settings: written as asked.
+    Write,
+    /// Torque enable: through the torque bookkeeping.
+    Torque,
+    /// Goal position: a motion, through the safety check.
+    Goal,
+    /// Refused.
+    Refused,
+}
+
+/// The policy for raw writes to register `addr`.
+pub fn access(addr: u8) -> Access {
+    match addr {
+        21..=27 | 37 | 39 | 41 | 44..=49 => Access::Write,
+        reg::TORQUE_ENABLE => Access::Torque,
+        42 | 43 => Access::Goal,
+        _ => Access::Refused,
+    }
+}
 
 /// The parts a servo access may touch.
 pub struct ServoAccess<'a> {
@@ -49,30 +88,24 @@ impl ServoAccess<'_> {
             ServoValue::Byte(b) => ([b, 0], 1),
             ServoValue::Word(w) => (w.to_le_bytes(), 2),
         };
-        let touches = |r: u8| addr <= r && r < addr.saturating_add(len);
-        if touches(reg::ID) || touches(reg::BAUD_RATE) {
-            return Err(AtomError::Invalid);
-        }
-        if addr == reg::TORQUE_ENABLE && value == ServoValue::Byte(128) {
-            return self.calibrate(now_us, index);
-        }
-        if addr == reg::TORQUE_ENABLE
-            && let ServoValue::Byte(b) = value
-        {
-            return if self.bank.set_torque(self.settings, index, b != 0) {
-                Ok(())
-            } else {
-                Err(AtomError::Invalid)
-            };
-        }
-        if touches(reg::GOAL_POSITION) || touches(reg::GOAL_POSITION + 1) {
-            return match value {
-                ServoValue::Word(w) if addr == reg::GOAL_POSITION => {
-                    let steps = Steps(sign_magnitude(w, 15));
-                    self.move_to_steps(index, steps)
-                }
-                _ => Err(AtomError::Invalid),
-            };
+        let last = addr.checked_add(len - 1).ok_or(AtomError::Invalid)?;
+        let kinds = (access(addr), access(last));
+        match (kinds, value) {
+            ((Access::Torque, Access::Torque), ServoValue::Byte(128)) => {
+                return self.calibrate(now_us, index);
+            }
+            ((Access::Torque, Access::Torque), ServoValue::Byte(b)) => {
+                return if self.bank.set_torque(self.settings, index, b != 0) {
+                    Ok(())
+                } else {
+                    Err(AtomError::Invalid)
+                };
+            }
+            ((Access::Goal, Access::Goal), ServoValue::Word(w)) if addr == reg::GOAL_POSITION => {
+                return self.move_to_steps(index, Steps(sign_magnitude(w, 15)));
+            }
+            ((Access::Write, Access::Write), _) => {}
+            _ => return Err(AtomError::Invalid),
         }
         let data = data.get(..usize::from(len)).ok_or(AtomError::Invalid)?;
         let eeprom = addr < FIRST_RAM_REGISTER;
@@ -172,13 +205,24 @@ impl ServoAccess<'_> {
     }
 }
 
+/// Fastest goal speed a drag (0x3E) may ask for, steps per second: the STS3215's top speed.
+pub const MAX_DRAG_SPEED_STEPS_PER_S: i16 = 3_400;
+
 /// Moves the joints to six encoder positions with their own speeds (0x3E set encoders drag).
+/// A speed of 0 (the servo would read it as "as fast as you can"), a negative one or one above
+/// [`MAX_DRAG_SPEED_STEPS_PER_S`] is refused: nothing creeps and nothing races.
 pub fn drag_to(
     bank: &mut ServoBank,
     settings: &Settings,
     encoders: [Steps; JOINTS],
     speeds_steps_per_s: [i16; JOINTS],
 ) -> Result<(), AtomError> {
+    if speeds_steps_per_s
+        .iter()
+        .any(|s| !(1..=MAX_DRAG_SPEED_STEPS_PER_S).contains(s))
+    {
+        return Err(AtomError::Invalid);
+    }
     let accel = settings.config().joint_accel_register();
     let mut goals: GoalSet = [None; SERVOS];
     for (slot, (e, s)) in goals
@@ -187,9 +231,28 @@ pub fn drag_to(
     {
         *slot = Some(Goal {
             position: *e,
-            speed_steps_per_s: s.unsigned_abs().max(1),
+            speed_steps_per_s: s.unsigned_abs(),
             accel,
         });
     }
     bank.send_goals(settings, goals)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_tuning_and_motion_registers_are_writable() {
+        for addr in [
+            5, 6, 7, 8, 9, 11, 13, 16, 19, 20, 28, 30, 31, 32, 33, 36, 55, 56, 70,
+        ] {
+            assert_eq!(access(addr), Access::Refused, "register {addr}");
+        }
+        for addr in [21, 22, 23, 24, 26, 27, 41, 44, 46, 48] {
+            assert_eq!(access(addr), Access::Write, "register {addr}");
+        }
+        assert_eq!(access(40), Access::Torque);
+        assert_eq!(access(42), Access::Goal);
+    }
 }

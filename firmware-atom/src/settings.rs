@@ -4,7 +4,7 @@
 use protocol_core::units::{Centideg, Decideg, Steps};
 
 use crate::cartesian::Cartesian;
-use crate::config::{AtomConfig, JOINTS, JointLimit};
+use crate::config::{AtomConfig, FACTORY_LIMITS, JOINTS, JointLimit};
 use crate::error::AtomError;
 
 /// The Atom's settings: its configuration and what the host changed at run time.
@@ -47,8 +47,10 @@ impl Settings {
         self.limits.get(j).copied()
     }
 
-    /// Sets joint `j`'s lower and/or upper limit (0x4C/0x4D); refused if min would exceed max
-    /// or a limit would leave +-180 degrees.
+    /// Sets joint `j`'s lower and/or upper limit (0x4C/0x4D). Refused if min would exceed max
+    /// ([`AtomError::Invalid`]) or a limit would leave the factory range
+    /// ([`crate::config::FACTORY_LIMITS`]; [`AtomError::JointLimit`], so 0x07 reports the
+    /// joint): a limit can be narrowed, never widened beyond what the arm can do.
     pub fn set_limit(
         &mut self,
         j: usize,
@@ -59,7 +61,11 @@ impl Settings {
         let to_cd = |d: Decideg| i32::from(d.0) * 10;
         let new_min = min.map_or(i32::from(limit.min.0), to_cd);
         let new_max = max.map_or(i32::from(limit.max.0), to_cd);
-        if new_min > new_max || new_min < -18_000 || new_max > 18_000 {
+        let factory = FACTORY_LIMITS.get(j).ok_or(AtomError::Invalid)?;
+        if new_min < i32::from(factory.min.0) || new_max > i32::from(factory.max.0) {
+            return Err(AtomError::JointLimit(j));
+        }
+        if new_min > new_max {
             return Err(AtomError::Invalid);
         }
         if let Some(l) = self.limits.get_mut(j) {
@@ -148,15 +154,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_limit_is_refused_when_inverted_or_beyond_a_half_turn() {
+    fn a_limit_is_refused_when_inverted_or_beyond_the_factory_range() {
         let mut s = Settings::new(AtomConfig::default());
         assert_eq!(
             s.set_limit(0, Some(Decideg(100)), Some(Decideg(-100))),
             Err(AtomError::Invalid)
         );
         assert_eq!(
-            s.set_limit(0, Some(Decideg(-1_810)), None),
-            Err(AtomError::Invalid)
+            s.set_limit(0, Some(Decideg(-1_690)), None),
+            Err(AtomError::JointLimit(0)),
+            "beyond the factory range"
+        );
+        assert_eq!(
+            s.set_limit(1, Some(Decideg(-1_700)), None),
+            Err(AtomError::JointLimit(1))
         );
         assert_eq!(s.set_limit(0, None, Some(Decideg(900))), Ok(()));
         assert_eq!(s.limit(0).map(|l| l.max), Some(Centideg(9_000)));

@@ -765,3 +765,30 @@ fn power_on_while_powered_does_not_cut_a_move_short() {
     let end = angles(&mut rig);
     assert!(close(&end, &target, 10), "{end:?}");
 }
+
+#[test]
+fn an_atom_restarted_mid_move_lets_the_move_finish_and_keeps_the_arm_powered() {
+    let mut rig = Rig::new();
+    let target = [6000i16, -3000, 0, 0, 0, 0];
+    let mut data = be(&target);
+    data.push(50);
+    assert_eq!(rig.ask(SEND_ANGLES, &data), [1]);
+    rig.run_ms(300);
+    // The Atom reboots (the real arm's configuration: unpowered at boot until told).
+    rig.atom = firmware_atom::Atom::new(firmware_atom::AtomConfig::default());
+    rig.run_ms(4000);
+    for id in 1..=6 {
+        assert!(rig.bus.servo(id).torque_enabled(), "servo {id} went limp");
+    }
+    let end = angles(&mut rig);
+    assert!(close(&end, &target, 10), "{end:?}");
+    assert_eq!(
+        rig.ask(0x12, &[]),
+        [1],
+        "the restarted Atom knows the arm is powered"
+    );
+    // The Basic's power on after the restart changes nothing.
+    assert_eq!(rig.ask(0x10, &[]), [1]);
+    rig.run_ms(200);
+    assert!(close(&angles(&mut rig), &target, 10));
+}

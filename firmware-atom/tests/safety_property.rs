@@ -1,24 +1,31 @@
-//! Property: whatever arrives from the host (valid commands, out-of-range values, garbage,
-//! truncated frames), the Atom never panics and never sends a servo a goal outside the joint
-//! limits or a gripper goal that is not an encoder position.
+//! Property: whatever arrives from the host (valid commands, out-of-range values, raw register
+//! writes to any register, limit changes, garbage, truncated frames), the Atom never panics,
+//! never sends a servo a goal outside the factory joint range or a gripper goal that is not an
+//! encoder position, and never changes a joint's zero (its homing offset) except through a
+//! calibration.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
 
 mod support;
 
-use firmware_atom::config::DEFAULT_LIMITS;
+use firmware_atom::config::FACTORY_LIMITS;
 use firmware_atom::{AtomConfig, JointLimit};
 use proptest::prelude::*;
 use protocol_core::Frame;
 use protocol_core::units::Steps;
 use support::rig::Rig;
 
-/// Commands a fuzzer should hit often: motion, jog, encoders, servo data, gripper, frames.
-/// Joint limits (0x4C/0x4D) are left out so the limits stay the defaults checked below.
+/// Commands a fuzzer should hit often: motion, jog, encoders, limits, servo data, gripper,
+/// frames.
 const COMMANDS: &[u8] = &[
     0x05, 0x10, 0x11, 0x13, 0x16, 0x1A, 0x20, 0x21, 0x22, 0x23, 0x24, 0x25, 0x26, 0x28, 0x29, 0x2A,
-    0x30, 0x31, 0x32, 0x33, 0x34, 0x3A, 0x3C, 0x3E, 0x52, 0x53, 0x54, 0x55, 0x56, 0x57, 0x66, 0x67,
-    0x68, 0x81, 0x83, 0x85, 0x87, 0x89, 0x8D,
+    0x30, 0x31, 0x32, 0x33, 0x34, 0x3A, 0x3C, 0x3E, 0x4C, 0x4D, 0x52, 0x53, 0x54, 0x55, 0x56, 0x57,
+    0x66, 0x67, 0x68, 0x81, 0x83, 0x85, 0x87, 0x89, 0x8D,
 ];
+
+/// Commands that calibrate (make a servo's present position its zero).
+fn calibrates(cmd: u8, data: &[u8]) -> bool {
+    cmd == 0x54 || cmd == 0x68 || (cmd == 0x52 && data.get(1) == Some(&40))
+}
 
 #[derive(Clone, Debug)]
 enum Input {
@@ -53,17 +60,17 @@ fn structured() -> impl Strategy<Value = Input> {
             d.push(s);
             Input::Command(0x22, d)
         }),
-        (
-            1u8..=7,
-            prop::sample::select(vec![40u8, 41, 42, 43]),
-            any::<u16>()
-        )
-            .prop_map(|(id, addr, v)| {
-                let mut d = vec![id, addr];
-                d.extend(v.to_be_bytes());
-                d.push(1);
-                Input::Command(0x52, d)
-            }),
+        (1u8..=7, register(), any::<u16>(), any::<bool>()).prop_map(|(id, addr, v, word)| {
+            let mut d = vec![id, addr];
+            d.extend(v.to_be_bytes());
+            d.push(u8::from(word));
+            Input::Command(0x52, d)
+        }),
+        (0x4Cu8..=0x4D, 1u8..=6, -2_000i16..2_000).prop_map(|(cmd, j, limit)| {
+            let mut d = vec![j];
+            d.extend(be(&[limit]));
+            Input::Command(cmd, d)
+        }),
         (1u8..=7, 0i16..=4096, 1u8..=100).prop_map(|(id, e, s)| {
             let mut d = vec![id];
             d.extend(be(&[e]));
@@ -71,6 +78,15 @@ fn structured() -> impl Strategy<Value = Input> {
             Input::Command(0x3A, d)
         }),
         (0u8..=100, 1u8..=100).prop_map(|(v, s)| Input::Command(0x67, vec![v, s])),
+    ]
+}
+
+/// A register to write raw: often one that changes what a position means (limits 9..12, homing
+/// offset 31..32, operating mode 33) or a neighbour, sometimes any.
+fn register() -> impl Strategy<Value = u8> {
+    prop_oneof![
+        2 => prop::sample::select(vec![8u8, 9, 10, 11, 12, 30, 31, 32, 33, 40, 41, 42, 43, 55]),
+        1 => 5u8..=70,
     ]
 }
 
@@ -95,9 +111,12 @@ proptest! {
     fn no_input_sends_an_out_of_limit_goal(inputs in prop::collection::vec(input(), 1..24)) {
         let config = AtomConfig { powered_at_boot: true, ..AtomConfig::default() };
         let mut rig = Rig::with(config, true);
+        let zeros: Vec<u16> = (1..=7).map(|id| rig.bus.servo(id).reg_u16(31)).collect();
+        let mut calibrated = false;
         for input in &inputs {
             match input {
                 Input::Command(cmd, data) => {
+                    calibrated |= calibrates(*cmd, data);
                     if let Some(frame) = Frame::new(*cmd, data) {
                         rig.bus.send_frame(&frame);
                     }
@@ -109,13 +128,62 @@ proptest! {
             rig.run_ms(3);
         }
         rig.run_ms(100);
-        for (j, (goals, limit)) in rig.bus.goals.iter().zip(&DEFAULT_LIMITS).enumerate() {
+        if !calibrated {
+            for id in 1..=7u8 {
+                prop_assert_eq!(
+                    rig.bus.servo(id).reg_u16(31),
+                    zeros[usize::from(id) - 1],
+                    "servo {}'s zero moved",
+                    id
+                );
+            }
+        }
+        for (j, (goals, limit)) in rig.bus.goals.iter().zip(&FACTORY_LIMITS).enumerate() {
             for &g in goals {
                 prop_assert!(within(limit, g, &config, j), "joint {} goal {}", j + 1, g);
             }
         }
         for &g in &rig.bus.goals[6] {
             prop_assert!((0..4096).contains(&g), "gripper goal {}", g);
+        }
+    }
+}
+
+/// A raw write (0x52) to any register other than torque enable, one or two bytes.
+fn raw_write() -> impl Strategy<Value = (u8, u8, u16, bool)> {
+    (1u8..=7, register(), any::<u16>(), any::<bool>()).prop_filter(
+        "torque enable (40) is the calibration path",
+        |(_, addr, _, _)| *addr != 40,
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, .. ProptestConfig::default() })]
+
+    #[test]
+    fn no_raw_write_moves_a_joints_zero_or_its_range(writes in prop::collection::vec(raw_write(), 1..16)) {
+        let config = AtomConfig { powered_at_boot: true, ..AtomConfig::default() };
+        let mut rig = Rig::with(config, true);
+        rig.run_ms(20);
+        let before: Vec<[u16; 3]> = (1..=7)
+            .map(|id| {
+                let s = rig.bus.servo(id);
+                [s.reg_u16(31), s.reg_u16(9), s.reg_u16(11)]
+            })
+            .collect();
+        for (id, addr, value, word) in writes {
+            let mut d = vec![id, addr];
+            d.extend(value.to_be_bytes());
+            d.push(u8::from(word));
+            rig.bus.send_frame(&Frame::new(0x52, &d).unwrap());
+            rig.run_ms(5);
+        }
+        rig.run_ms(50);
+        for id in 1..=7u8 {
+            let s = rig.bus.servo(id);
+            let after = [s.reg_u16(31), s.reg_u16(9), s.reg_u16(11)];
+            prop_assert_eq!(after, before[usize::from(id) - 1], "servo {}: zero or own limits changed", id);
+            prop_assert_eq!(s.reg(33), 0, "servo {} left position mode", id);
         }
     }
 }

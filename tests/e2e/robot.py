@@ -10,6 +10,7 @@ The robot is started by tests/pymycobot.rs (or by hand: `cargo run --release -- 
 
 import math
 import os
+import struct
 import time
 import unittest
 
@@ -41,6 +42,16 @@ def arm():
         _arm = MyCobot280(PORT)
         first_contact = (_arm.is_power_on(), _arm.get_angles())
     return _arm
+
+
+def frame(cmd, *data):
+    """A raw host frame, for requests pymycobot itself would refuse to send."""
+    return bytes([0xFE, 0xFE, len(data) + 2, cmd, *data, 0xFA])
+
+
+def i16(value):
+    """A big-endian int16 as two bytes."""
+    return list(struct.pack(">h", value))
 
 
 def wait_until(predicate, timeout, interval=0.02):
@@ -163,6 +174,15 @@ class RobotTestCase(unittest.TestCase):
         self.assertLessEqual(
             rotation_error_deg(actual[3:], expected[3:]), rot_tol, f"{msg}: orientation {actual} vs {expected}"
         )
+
+    def send_raw(self, request):
+        """Writes one raw request; returns whatever came back within 0.3 s."""
+        port = self.mc._serial_port
+        with self.mc.lock:
+            port.reset_input_buffer()
+            port.write(request)
+            time.sleep(0.3)
+            return port.read(port.in_waiting)
 
     # ----- motion helpers
 

@@ -1,20 +1,10 @@
 """Requests other clients might send that pymycobot never would: out-of-range values, wrong
 lengths, unknown commands. The arm must stay put, keep answering, and say what was wrong."""
 
-import struct
 import time
 import unittest
 
-from robot import RobotTestCase, wait_until
-
-
-def frame(cmd, *data):
-    return bytes([0xFE, 0xFE, len(data) + 2, cmd, *data, 0xFA])
-
-
-def i16(value):
-    return list(struct.pack(">h", value))
-
+from robot import RobotTestCase, frame, i16, wait_until
 
 ZERO_ANGLES = sum((i16(0) for _ in range(6)), [])
 
@@ -42,15 +32,6 @@ BAD_REQUESTS = {
 
 
 class BadInputTest(RobotTestCase):
-    def send_raw(self, request):
-        """Writes one raw request; returns whatever came back within 0.3 s."""
-        port = self.mc._serial_port
-        with self.mc.lock:
-            port.reset_input_buffer()
-            port.write(request)
-            time.sleep(0.3)
-            return port.read(port.in_waiting)
-
     def test_the_arm_stays_put_and_keeps_answering(self):
         self.home()
         for name, request in BAD_REQUESTS.items():
