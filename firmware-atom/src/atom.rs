@@ -1107,4 +1107,10 @@ impl Atom {
         }
         ((pos - closed) * 100 / span).clamp(0, 100) as u8
     }
+
+    /// The coordinate frames the host selected (tool pose, world pose, reference frame, end
+    /// type) and the kinematics model they configure, as coordinates are reported with.
+    pub fn cartesian(&self) -> &Cartesian {
+        &self.cart
+    }
 }
