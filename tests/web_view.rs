@@ -34,7 +34,7 @@ use view_page::{PAGE_DEADLINE, READOUT_ANGLES, numbers, wait_until_drawn};
 const WIDTH: u32 = 1000;
 const HEIGHT: u32 = 640;
 const PANEL_PX: u32 = 320;
-/// Share of the scene the arm's links cover at least, drawn (1.4 to 1.7 % in the poses used).
+/// Share of the scene the arm's links cover at least, drawn (about 2 % in the poses used).
 const DRAWN_FRACTION: f64 = 0.005;
 /// Share of the arm's pixels that must change with the move.
 const MOVED_FRACTION: f64 = 0.3;
@@ -129,23 +129,34 @@ fn save(name: &str, png_bytes: &[u8]) -> PathBuf {
     path
 }
 
-/// Moves the arm with pymycobot; returns the angles it reads back.
-fn move_with_pymycobot(link: &Path) -> Vec<f64> {
+/// Runs the Python lines `script` with `mc`, a pymycobot MyCobot280 on `link`; returns what
+/// they printed.
+fn run_pymycobot(link: &Path, script: &str) -> String {
     let script = format!(
-        "import json, os, warnings\n\
+        "import json, os, time, warnings\n\
          warnings.filterwarnings('ignore')\n\
          from pymycobot import MyCobot280\n\
          mc = MyCobot280(os.environ['MYCOBOT_PORT'])\n\
-         mc.set_color(0, 200, 255)\n\
-         mc.set_gripper_value(60, 80)\n\
-         mc.sync_send_angles({TARGET_DEG:?}, 80, timeout=15)\n\
-         print(json.dumps(mc.get_angles()))\n"
+         {script}"
     );
-    let out = venv::run_checked(
+    venv::run_checked(
         Command::new(venv::python())
             .arg("-c")
             .arg(script)
             .env("MYCOBOT_PORT", link),
+    )
+}
+
+/// Moves the arm with pymycobot; returns the angles it reads back.
+fn move_with_pymycobot(link: &Path) -> Vec<f64> {
+    let out = run_pymycobot(
+        link,
+        &format!(
+            "mc.set_color(0, 200, 255)\n\
+             mc.set_gripper_value(60, 80)\n\
+             mc.sync_send_angles({TARGET_DEG:?}, 80, timeout=15)\n\
+             print(json.dumps(mc.get_angles()))\n"
+        ),
     );
     let angles: Value = serde_json::from_str(out.trim())
         .unwrap_or_else(|e| panic!("pymycobot printed {out:?}: {e}"));
@@ -213,25 +224,21 @@ fn the_page_draws_the_arm_and_shows_it_move() {
     assert_eq!(led, "#00c8ff", "the LED colour set with set_color");
 
     // ...and it drew the flange where kinematics-core puts it for the angles it shows.
-    let (shown, flange) = {
+    let (shown, drawn) = {
         let both = browser
             .evaluate(
                 &page,
-                &format!("[{READOUT_ANGLES}, document.body.dataset.flangeMm]"),
+                &format!("[{READOUT_ANGLES}, window.viewStats.flangeMm]"),
             )
             .expect("evaluate");
-        (
-            numbers(&both[0]),
-            both[1].as_str().unwrap_or("").to_string(),
-        )
+        (numbers(&both[0]), numbers(&both[1]))
     };
-    let drawn: Vec<f64> = flange.split(',').filter_map(|v| v.parse().ok()).collect();
     let q = kinematics_core::JointAngles(std::array::from_fn(|j| {
         (shown.get(j).copied().unwrap_or(0.0) * 100.0).round() as i32
     }));
     let pose = kinematics_core::Kinematics::new().forward(&q);
     let expected = [pose.x, pose.y, pose.z].map(|tenths| f64::from(tenths) / 10.0);
-    assert_eq!(drawn.len(), 3, "flange {flange:?}");
+    assert_eq!(drawn.len(), 3, "flange {drawn:?}");
     for (d, e) in drawn.iter().zip(expected) {
         assert!(
             (d - e).abs() <= 0.2,

@@ -1,6 +1,6 @@
 //! What the browser tests and benches read off the 3D view's page (included with `#[path]`
-//! after `chromium.rs`): the page marks its progress on `<body>` (`data-received`: state
-//! messages, `data-drawn`: renders, `data-flange-mm`: where it drew the flange).
+//! after `chromium.rs`): the page counts its progress in `window.viewStats` (`received`:
+//! state messages, `drawn`: renders, `flangeMm`: where it drew the flange, [x, y, z]).
 #![allow(dead_code)]
 
 use std::time::Duration;
@@ -17,7 +17,7 @@ pub const READOUT_ANGLES: &str =
     "[...document.querySelectorAll('#joints td')].map(td => Number(td.textContent))";
 
 /// How many state messages the page has received.
-pub const RECEIVED: &str = "Number(document.body ? document.body.dataset.received || 0 : 0)";
+pub const RECEIVED: &str = "window.viewStats ? window.viewStats.received : 0";
 
 /// The numbers in a JSON array (empty if it is none).
 pub fn numbers(value: &Value) -> Vec<f64> {
@@ -33,14 +33,14 @@ pub fn wait_until_drawn(browser: &mut Chromium, page: &Page) {
     let (value, ok) = browser
         .wait_for(
             page,
-            "(() => { const d = document.body ? document.body.dataset : {}; \
-             return [Number(d.received || 0), Number(d.drawn || 0), d.flangeMm || '', \
+            "(() => { const s = window.viewStats || {}; \
+             return [s.received || 0, s.drawn || 0, s.flangeMm || null, \
              window.testMark === undefined]; })()",
             PAGE_DEADLINE,
             |v| {
                 v[0].as_f64() >= Some(5.0)
                     && v[1].as_f64() >= Some(1.0)
-                    && v[2] != ""
+                    && v[2].is_array()
                     && v[3] == true
             },
         )

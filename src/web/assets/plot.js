@@ -12,18 +12,29 @@ export class AnglePlot {
     this.context = canvas.getContext('2d');
     this.seconds = seconds;
     this.samples = []; // {t, angles}, oldest first
+    this.full = false; // whether samples older than the window were dropped
+    this.changedAt = 0; // robot time of the last change of the angles
   }
 
-  // Adds the angles at robot time `t` (s). A robot that restarted (time went back) starts a
-  // fresh plot.
+  // Adds the angles at robot time `t` (s); tells whether the plot now looks different. It
+  // does not once it is full of one unchanging pose (an arm at rest for the whole window).
+  // A robot that restarted (time went back) starts a fresh plot.
   push(t, angles) {
     const last = this.samples[this.samples.length - 1];
-    if (last && t < last.t) this.samples = [];
+    if (last && t < last.t) {
+      this.samples = [];
+      this.full = false;
+    }
+    if (!last || t < last.t || angles.some((a, j) => a !== last.angles[j])) this.changedAt = t;
     this.samples.push({ t, angles });
     const oldest = t - this.seconds;
     let drop = 0;
     while (drop < this.samples.length && this.samples[drop].t < oldest) drop++;
-    if (drop > 0) this.samples.splice(0, drop);
+    if (drop > 0) {
+      this.samples.splice(0, drop);
+      this.full = true;
+    }
+    return !(this.full && t - this.changedAt > this.seconds);
   }
 
   draw() {

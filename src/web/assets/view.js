@@ -29,11 +29,9 @@ function showReadout(state) {
   const hex = '#' + state.led.map((c) => c.toString(16).padStart(2, '0')).join('');
   $('led-swatch').style.background = hex;
   $('led').textContent = hex;
-  $('status').textContent = [
-    state.powered ? 'powered on' : 'powered off',
-    state.moving ? 'moving' : 'at rest',
-    `t = ${state.t_s.toFixed(1)} s`,
-  ].join(' \u00b7 ');
+  $('status').textContent = [state.powered ? 'powered on' : 'powered off', state.moving ? 'moving' : 'at rest'].join(
+    ' \u00b7 ',
+  );
 }
 
 function showLink(up) {
@@ -70,9 +68,9 @@ function buildScene(model) {
 
   const camera = new THREE.PerspectiveCamera(40, 1, 5, 5000);
   camera.up.set(0, 0, 1);
-  camera.position.set(560, -700, 420);
+  camera.position.set(470, -600, 400);
   const controls = new OrbitControls(camera, canvas);
-  controls.target.set(0, 0, 190);
+  controls.target.set(30, 0, 180);
   controls.update();
 
   const resize = () => {
@@ -87,13 +85,27 @@ function buildScene(model) {
 
 // --- main ------------------------------------------------------------------------------
 
+// What the page has done, for the browser tests and the cost bench (read over DevTools; kept
+// out of the DOM so that counting costs no style or layout work).
+const stats = { received: 0, drawn: 0, flangeMm: null };
+window.viewStats = stats;
+
+// The plot scrolls with time; it is redrawn at most this often while it changes.
+const PLOT_PERIOD_MS = 50;
+
 const plot = new AnglePlot($('plot'));
 let view = null; // the scene, once the model has loaded and WebGL works
 let latest = null; // the last state received
-let posed = ''; // what the arm was last posed with (to skip unchanged frames)
+let shown = ''; // what the readout and the arm last showed (keyOf)
 let sceneDirty = true;
+let plotDirty = false;
+let plotDrawnAt = 0;
 let scheduled = false;
-let received = 0;
+
+// Everything in a state message that is read out or drawn, except the time: an arm at rest
+// sends the same key 60 times a second, and then the page does nothing.
+const keyOf = (s) =>
+  JSON.stringify([s.angles_deg, s.coords, s.end, s.frame, s.tool, s.gripper, s.led, s.powered, s.moving]);
 
 function schedule() {
   if (!scheduled) {
@@ -102,27 +114,31 @@ function schedule() {
   }
 }
 
-function draw() {
+function draw(now) {
   scheduled = false;
-  if (latest) {
+  if (latest && keyOf(latest) !== shown) {
+    shown = keyOf(latest);
     showReadout(latest);
-    plot.draw();
-  }
-  if (!view) return;
-  if (latest) {
-    const key = JSON.stringify([latest.angles_deg, latest.gripper, latest.led, latest.tool, latest.end]);
-    if (key !== posed) {
+    if (view) {
       view.arm.pose(latest);
-      posed = key;
       sceneDirty = true;
       const f = view.arm.flangeMm();
-      document.body.dataset.flangeMm = [f.x, f.y, f.z].map((v) => v.toFixed(1)).join(',');
+      stats.flangeMm = [f.x, f.y, f.z];
     }
   }
-  if (sceneDirty) {
+  if (plotDirty) {
+    if (now - plotDrawnAt >= PLOT_PERIOD_MS) {
+      plot.draw();
+      plotDrawnAt = now;
+      plotDirty = false;
+    } else {
+      schedule();
+    }
+  }
+  if (view && sceneDirty) {
     view.renderer.render(view.scene, view.camera);
     sceneDirty = false;
-    document.body.dataset.drawn = String(Number(document.body.dataset.drawn || 0) + 1);
+    stats.drawn += 1;
   }
 }
 
@@ -131,10 +147,9 @@ function connect() {
   socket.onopen = () => showLink(true);
   socket.onmessage = (event) => {
     latest = JSON.parse(event.data);
-    received += 1;
-    document.body.dataset.received = String(received);
-    plot.push(latest.t_s, latest.angles_deg);
-    schedule();
+    stats.received += 1;
+    plotDirty = plot.push(latest.t_s, latest.angles_deg) || plotDirty;
+    if (plotDirty || keyOf(latest) !== shown) schedule();
   };
   socket.onclose = () => {
     showLink(false);
@@ -147,6 +162,7 @@ async function start() {
     const model = await (await fetch('/model.json')).json();
     view = buildScene(model);
     view.resize();
+    shown = ''; // pose the arm with the state that came before the scene
     view.controls.addEventListener('change', () => {
       sceneDirty = true;
       schedule();
