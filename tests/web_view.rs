@@ -292,3 +292,41 @@ fn the_page_draws_the_arm_and_shows_it_move() {
         assert!(ok, "a reloaded or second page shows {shown}");
     }
 }
+
+/// Makes the README's picture, docs/view.png: a tool frame set, the LED lit, and a few moves so
+/// the plot has something to show. By hand:
+/// `cargo test --release --test web_view -- --ignored readme_screenshot`.
+#[test]
+#[ignore = "writes docs/view.png; run by hand"]
+fn readme_screenshot() {
+    let link = scratch("readme-link");
+    let _ = std::fs::remove_file(&link);
+    let robot = launch(&[
+        "--pty-link",
+        link.to_str().expect("UTF-8"),
+        "--web",
+        "127.0.0.1:0",
+    ]);
+    let url = robot
+        .banner_value("view on ")
+        .expect("view address")
+        .to_string();
+    let mut browser = Chromium::launch(scratch("readme-profile")).unwrap_or_else(|e| panic!("{e}"));
+    let page = browser.open(&url, WIDTH, HEIGHT).expect("open the view");
+    wait_until_drawn(&mut browser, &page);
+    run_pymycobot(
+        &link,
+        "mc.set_color(60, 220, 120)\n\
+         mc.set_tool_reference([0, 0, 90, 0, 0, 0])\n\
+         mc.set_end_type(1)\n\
+         mc.set_gripper_value(70, 80)\n\
+         mc.sync_send_angles([35, -25, -45, 10, 40, 20], 70, timeout=15)\n\
+         mc.sync_send_angles([-25, -55, -25, 25, 60, -30], 70, timeout=15)\n\
+         mc.sync_send_angles([40, -35, -55, 5, 35, 30], 70, timeout=15)\n\
+         time.sleep(0.5)\n",
+    );
+    let png = browser.screenshot(&page).expect("screenshot");
+    let path = venv::workspace().join("docs/view.png");
+    std::fs::write(&path, &png).expect("write docs/view.png");
+    println!("wrote {} ({} bytes)", path.display(), png.len());
+}
