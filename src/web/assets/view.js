@@ -170,6 +170,7 @@ async function start() {
     window.addEventListener('resize', () => {
       view.resize();
       sceneDirty = true;
+      plotDirty = true; // its canvas takes the new width when drawn
       schedule();
     });
     schedule();
