@@ -1,12 +1,8 @@
 //! `cargo test` runs the Python end-to-end suite (tests/e2e/) with the real client, pymycobot
 //! 4.0.7, against the real binary: the virtual robot in real time on a pseudo-terminal and TCP.
-//!
-//! The interpreter is `$MYCOBOT_PYTHON`, else the workspace's `.venv/bin/python`; on a fresh
-//! clone the venv is created (`python3 -m venv .venv && pip install pymycobot==4.0.7`) under a
-//! file lock, so parallel test binaries do not race. Nothing is skipped silently: a missing
-//! Python or a failed install fails the test with the reason.
+//! The interpreter is the one `e2e/venv.rs` finds or sets up.
 
-use std::fs::{self, File};
+use std::fs;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -18,67 +14,14 @@ use nix::sys::signal::Signal;
 #[path = "e2e/launcher.rs"]
 mod launcher;
 use launcher::{Launched, launch};
+#[path = "e2e/venv.rs"]
+mod venv;
+use venv::{python, workspace};
 
-const PYMYCOBOT: &str = "pymycobot==4.0.7";
 /// The whole Python suite must finish within this (it runs in real time; ~2 min expected).
 const SUITE_DEADLINE: Duration = Duration::from_secs(360);
 
-fn workspace() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The Python to run the suite with; creates the workspace venv if needed.
-fn python() -> PathBuf {
-    if let Some(explicit) = std::env::var_os("MYCOBOT_PYTHON") {
-        return PathBuf::from(explicit);
-    }
-    let root = workspace();
-    let python = root.join(".venv/bin/python");
-    let lock = File::create(Path::new(env!("CARGO_TARGET_TMPDIR")).join("venv.lock"))
-        .expect("create the venv lock file");
-    lock.lock().expect("lock the venv lock file");
-    if !imports_pymycobot(&python) {
-        if !python.exists() {
-            run_checked(
-                Command::new("python3")
-                    .args(["-m", "venv"])
-                    .arg(root.join(".venv")),
-            );
-        }
-        run_checked(
-            Command::new(root.join(".venv/bin/pip")).args(["install", "--quiet", PYMYCOBOT]),
-        );
-        assert!(
-            imports_pymycobot(&python),
-            "pymycobot still not importable after installing it into {}",
-            python.display()
-        );
-    }
-    python
-}
-
-fn imports_pymycobot(python: &Path) -> bool {
-    Command::new(python)
-        .args(["-c", "import pymycobot, serial"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
-}
-
-fn run_checked(command: &mut Command) {
-    let output = command
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run {command:?}: {e}"));
-    assert!(
-        output.status.success(),
-        "{command:?} failed:\n{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    );
-}
-
-/// The robot for the suite: a pty link in the temp dir, TCP on a free port.
+/// The robot for the suite: a pty link in the temp dir, TCP and the view on free ports.
 struct Robot {
     launched: Launched,
     link: PathBuf,
@@ -89,7 +32,15 @@ impl Robot {
     fn start() -> Robot {
         let link = std::env::temp_dir().join(format!("open-mycobot-e2e-{}", std::process::id()));
         let link_arg = link.to_str().expect("temp dir path is UTF-8");
-        let launched = launch(&["--pty-link", link_arg, "--tcp", "127.0.0.1:0"]);
+        // The view on too (nobody watches it): the suite runs with the simulation publishing.
+        let launched = launch(&[
+            "--pty-link",
+            link_arg,
+            "--tcp",
+            "127.0.0.1:0",
+            "--web",
+            "127.0.0.1:0",
+        ]);
         let tcp = launched
             .banner_value("tcp on ")
             .unwrap_or_else(|| panic!("no TCP address in the banner:\n{}", launched.banner))

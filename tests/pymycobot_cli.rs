@@ -1,10 +1,10 @@
 //! The command line of the virtual robot as a user meets it: start-up banner, the pty symlink
-//! (stale ones replaced, user files never clobbered, removed on Ctrl-C), and clear errors.
-//! Speaks raw frames on the pseudo-terminal, so it needs no Python.
+//! (stale ones replaced, user files never clobbered, removed on Ctrl-C), the 3D view's address,
+//! and clear errors. Speaks raw frames on the pseudo-terminal, so it needs no Python.
 
 use std::fs::{self, OpenOptions};
 use std::io::{Read, Write};
-use std::net::TcpListener;
+use std::net::{TcpListener, TcpStream};
 use std::os::unix::fs::symlink;
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -38,7 +38,7 @@ fn serves_the_link_replaces_a_stale_one_and_removes_it_on_ctrl_c() {
     let link = dir.join("mycobot");
     symlink("/dev/pts/stale-from-a-killed-run", &link).unwrap();
 
-    let mut robot = launch(&["--pty-link", link.to_str().unwrap()]);
+    let mut robot = launch(&["--pty-link", link.to_str().unwrap(), "--no-web"]);
     let pts = robot
         .banner_value("virtual myCobot 280 on ")
         .unwrap_or_else(|| panic!("no pty path in the banner: {}", robot.banner));
@@ -88,14 +88,57 @@ fn refuses_to_replace_a_regular_file_with_the_link() {
 }
 
 #[test]
-fn a_busy_tcp_port_is_a_clear_error() {
-    let taken = TcpListener::bind("127.0.0.1:0").unwrap();
-    let addr = taken.local_addr().unwrap().to_string();
-    let out = run_to_end(&["--tcp", &addr]);
-    assert!(!out.status.success());
-    let stderr = String::from_utf8_lossy(&out.stderr);
+fn a_busy_tcp_or_view_port_is_a_clear_error() {
+    for (option, what) in [("--tcp", "listen"), ("--web", "view")] {
+        let taken = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = taken.local_addr().unwrap().to_string();
+        let out = run_to_end(&[option, &addr]);
+        assert!(!out.status.success(), "{option} {addr} started");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            stderr.contains(what) && stderr.contains(&addr) && stderr.contains("in use"),
+            "{option}: {stderr}"
+        );
+    }
+}
+
+/// The first bytes of the answer to `GET path` at `url` (`http://host:port`).
+fn http_get(url: &str, path: &str) -> String {
+    let addr = url.strip_prefix("http://").unwrap();
+    let mut stream = TcpStream::connect(addr).unwrap();
+    write!(stream, "GET {path} HTTP/1.1\r\nHost: {addr}\r\n\r\n").unwrap();
+    let mut reply = String::new();
+    stream.read_to_string(&mut reply).unwrap();
+    reply
+}
+
+#[test]
+fn the_view_is_served_where_the_banner_says_and_can_be_turned_off() {
+    let robot = launch(&["--web", "127.0.0.1:0"]);
+    let url = robot
+        .banner_value("view on ")
+        .unwrap_or_else(|| panic!("no view address in the banner: {}", robot.banner));
+    let page = http_get(url, "/");
     assert!(
-        stderr.contains(&addr) && stderr.contains("in use"),
-        "{stderr}"
+        page.starts_with("HTTP/1.1 200") && page.contains("<canvas"),
+        "{page}"
     );
+    assert!(http_get(url, "/model.json").contains("\"d_mm\":[131.22,"));
+
+    let quiet = launch(&["--no-web"]);
+    assert!(quiet.banner_value("view on ").is_none(), "{}", quiet.banner);
+}
+
+#[test]
+fn when_the_default_view_port_is_taken_another_is_used_and_said() {
+    // Held here, or already held by someone else: either way it is taken.
+    let _held = TcpListener::bind("127.0.0.1:8280");
+    let robot = launch(&[]);
+    let line = robot
+        .banner_value("view on ")
+        .unwrap_or_else(|| panic!("no view address in the banner: {}", robot.banner));
+    let (url, note) = line.split_once(' ').unwrap_or((line, ""));
+    assert_eq!(note, "(127.0.0.1:8280 is in use)", "{line}");
+    assert!(!url.ends_with(":8280"), "{line}");
+    assert!(http_get(url, "/").starts_with("HTTP/1.1 200"));
 }

@@ -256,4 +256,10 @@ impl Atom {
     pub fn gripper_moving(&self) -> bool {
         self.parts.bank.servo_moving(GRIPPER)
     }
+
+    /// The coordinate frames the host selected (tool pose, world pose, reference frame, end
+    /// type) and the kinematics model they configure, as coordinates are reported with.
+    pub fn cartesian(&self) -> &crate::cartesian::Cartesian {
+        self.parts.settings.cart()
+    }
 }

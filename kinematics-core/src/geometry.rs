@@ -48,7 +48,12 @@ impl Default for ArmGeometry {
     }
 }
 
-/// DH alpha of each joint, as (sin, cos) in Q30: the structure the closed-form IK relies on.
+/// DH alpha of each joint, centidegrees: the structure the closed-form IK relies on (the same
+/// for every [`ArmGeometry`]). Published for models drawn outside this crate (the virtual
+/// robot's 3D view); [`ALPHA_SIN_COS`] is the form the chain computes with.
+pub const DH_ALPHA_CENTIDEG: [i32; 6] = [9000, 0, 0, 9000, -9000, 0];
+
+/// [`DH_ALPHA_CENTIDEG`] as (sin, cos) in Q30.
 const ALPHA_SIN_COS: [(i64, i64); 6] =
     [(ONE, 0), (0, ONE), (0, ONE), (ONE, 0), (-ONE, 0), (0, ONE)];
 
@@ -105,5 +110,21 @@ impl Links {
             t = t.then(&self.link(i, self.theta(i, qi)));
         }
         t
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_published_alphas_are_the_ones_the_chain_uses() {
+        for (&centideg, &sin_cos) in DH_ALPHA_CENTIDEG.iter().zip(ALPHA_SIN_COS.iter()) {
+            assert_eq!(
+                Angle::from_centideg(centideg).sin_cos(),
+                sin_cos,
+                "{centideg}"
+            );
+        }
     }
 }

@@ -8,7 +8,8 @@ use clap::{Parser, ValueEnum};
 use crate::sim::HostLink;
 
 /// Virtual myCobot 280 M5: the real Basic and Atom firmware logic, simulated servos, served in
-/// real time on a pseudo-terminal (and optionally TCP) to pymycobot or any serial client.
+/// real time on a pseudo-terminal (and optionally TCP) to pymycobot or any serial client, with
+/// a live 3D view in the browser.
 #[derive(Debug, Parser)]
 #[command(version, about)]
 pub struct Cli {
@@ -27,6 +28,15 @@ pub struct Cli {
     /// cable) or the Atom's own USB port (a direct link to the arm's controller).
     #[arg(long, value_enum, default_value_t = Port::Basic)]
     pub port: Port,
+
+    /// Serve the live 3D view on ADDR:PORT (default 127.0.0.1:8280; if that is taken, a free
+    /// port is used and printed). A chosen address must be free; port 0 picks one.
+    #[arg(long, value_name = "ADDR:PORT", conflicts_with = "no_web")]
+    pub web: Option<SocketAddr>,
+
+    /// Do not serve the 3D view.
+    #[arg(long)]
+    pub no_web: bool,
 }
 
 /// A USB serial port of the virtual arm.
@@ -71,6 +81,24 @@ mod tests {
         assert_eq!(HostLink::from(atom.port), HostLink::AtomUsb);
 
         assert!(Cli::try_parse_from(["open-mycobot", "--tcp", "9000"]).is_err());
+    }
+
+    #[test]
+    fn the_view_is_on_by_default_and_can_be_moved_or_turned_off() {
+        let bare = Cli::try_parse_from(["open-mycobot"]).unwrap();
+        assert!(bare.web.is_none() && !bare.no_web);
+        let moved = Cli::try_parse_from(["open-mycobot", "--web", "127.0.0.1:0"]).unwrap();
+        assert_eq!(moved.web, Some("127.0.0.1:0".parse().unwrap()));
+        assert!(
+            Cli::try_parse_from(["open-mycobot", "--no-web"])
+                .unwrap()
+                .no_web
+        );
+        assert!(Cli::try_parse_from(["open-mycobot", "--web", "8280"]).is_err());
+        assert!(
+            Cli::try_parse_from(["open-mycobot", "--no-web", "--web", "127.0.0.1:0"]).is_err(),
+            "both is a contradiction"
+        );
     }
 
     #[test]

@@ -81,6 +81,25 @@ enum Talker {
     Tcp(ClientId),
 }
 
+/// Something that looks at the robot now and then from inside the loop (the web view takes its
+/// snapshot). It runs on the loop's thread, so it must be quick and must never wait.
+struct Observer<R> {
+    period: Duration,
+    next: Instant,
+    look: Box<dyn FnMut(&R) + Send>,
+}
+
+impl<R> Observer<R> {
+    /// Looks if it is time; keeps a steady rate, but never makes up for missed turns.
+    fn look_if_due(&mut self, robot: &R) {
+        let now = Instant::now();
+        if now >= self.next {
+            (self.look)(robot);
+            self.next = (self.next + self.period).max(now);
+        }
+    }
+}
+
 /// The real-time loop: a robot, its pseudo-terminal and optionally a TCP server.
 pub struct RealtimeDriver<R> {
     robot: R,
@@ -88,6 +107,7 @@ pub struct RealtimeDriver<R> {
     tcp: Option<TcpServer>,
     talker: Talker,
     pacer: LinePacer,
+    observer: Option<Observer<R>>,
 }
 
 impl<R: RealtimeRobot> RealtimeDriver<R> {
@@ -99,7 +119,24 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             tcp,
             talker: Talker::Pty,
             pacer: LinePacer::new(HOST_BAUD, WINDOW_BYTES),
+            observer: None,
         }
+    }
+
+    /// Calls `look` with the robot about every `period` of wall time (not more often; later
+    /// if the loop is busy), after virtual time has caught up. `look` runs on the loop's
+    /// thread: it must be quick and never wait, or the robot's answers are late.
+    pub fn observe_every(
+        mut self,
+        period: Duration,
+        look: impl FnMut(&R) + Send + 'static,
+    ) -> Self {
+        self.observer = Some(Observer {
+            period,
+            next: Instant::now(),
+            look: Box::new(look),
+        });
+        self
     }
 
     /// The pseudo-terminal clients open.
@@ -127,6 +164,9 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
                 virtual_at_sync = target_us;
             }
             self.robot.run_until(target_us);
+            if let Some(observer) = self.observer.as_mut() {
+                observer.look_if_due(&self.robot);
+            }
 
             let had_input = self.forward_client_input(&mut input)?;
 
@@ -340,6 +380,48 @@ mod tests {
             "advanced {largest} us at once"
         );
         assert_eq!(robot.advances_us.len(), 50);
+    }
+
+    /// Stands still; lets virtual time follow the wall clock.
+    struct IdleRobot {
+        now_us: u64,
+    }
+
+    impl RealtimeRobot for IdleRobot {
+        fn now_us(&self) -> u64 {
+            self.now_us
+        }
+        fn host_write(&mut self, _: &[u8]) {}
+        fn host_read(&mut self, _: &mut Vec<u8>) {}
+        fn run_until(&mut self, t_us: u64) {
+            self.now_us = t_us;
+        }
+    }
+
+    #[test]
+    fn an_observer_is_called_from_the_loop_and_no_more_often_than_its_period() {
+        let period = Duration::from_millis(20);
+        let looks = Arc::new(std::sync::Mutex::new(Vec::new()));
+        let stop = Arc::new(AtomicBool::new(false));
+        let robot = IdleRobot { now_us: 0 };
+        let start = Instant::now();
+        let driver = RealtimeDriver::new(robot, PseudoTerminal::open().unwrap(), None)
+            .observe_every(period, {
+                let looks = Arc::clone(&looks);
+                let stop = Arc::clone(&stop);
+                move |_: &IdleRobot| {
+                    let mut looks = looks.lock().unwrap();
+                    looks.push(Instant::now());
+                    if looks.len() == 10 {
+                        stop.store(true, Ordering::Relaxed);
+                    }
+                }
+            });
+        driver.run(&stop).unwrap();
+        let looks = looks.lock().unwrap();
+        assert_eq!(looks.len(), 10);
+        // The k-th look is due k periods after the start, never earlier.
+        assert!(looks[9] - start >= 9 * period, "{:?}", looks[9] - start);
     }
 
     /// Checks on every write that no more arrived than the 115200 line could carry.
