@@ -13,6 +13,7 @@
 //!
 //! `cargo bench --bench motion [stop|stream|line]`. Figures, not pass/fail; targets are printed
 //! next to them. `MOTION_TRACE=1` also prints each line's distance from its segment over time.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
 use std::f64::consts::TAU;
 

@@ -1,4 +1,5 @@
 //! A user works the end of the arm: the Atom's LEDs and pins, and the gripper.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
 mod sim_support;
 

@@ -1,5 +1,6 @@
 //! The host talks to the arm in the other ways users have: straight into the Atom's own USB
 //! port (with or without a Basic), and to the Basic's own pins.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
 mod sim_support;
 

@@ -1,6 +1,7 @@
 //! Straight-line moves (send_coords mode 1) stay straight when they wait in the queue (fresh
 //! mode 0): a user drawing a square with queued mode-1 moves saw the later sides bow out like
 //! joint moves.
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
 mod sim_support;
 

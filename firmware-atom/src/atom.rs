@@ -13,7 +13,8 @@
 use protocol_core::units::{Centideg, Steps};
 use protocol_core::{BytePort, Frame};
 
-use crate::bank::ServoBank;
+use crate::backup::Backups;
+use crate::bank::{Completion, ServoBank};
 use crate::config::{AtomConfig, ConfigError, GRIPPER, JOINTS, JointLimit};
 use crate::error::ErrorLog;
 use crate::gripper::Gripper;
@@ -37,6 +38,8 @@ pub(crate) struct Parts {
     pub gripper: Gripper,
     /// The error state (0x07).
     pub errors: ErrorLog,
+    /// Servo parameter backups (0xEA/0xEB).
+    pub backups: Backups,
 }
 
 /// The Atom firmware. Create it once with [`Atom::new`] and call [`Atom::poll`] in a loop.
@@ -63,6 +66,7 @@ impl Atom {
                 motion: MotionController::new(),
                 gripper: Gripper::new(&settings),
                 errors: ErrorLog::default(),
+                backups: Backups::default(),
                 settings,
             },
             schedule: BusSchedule::new(config.timing.reply_margin_us),
@@ -95,7 +99,7 @@ impl Atom {
         }
         self.receive_usb(now_us, usb, io);
         if let Some((op, outcome)) = self.schedule.poll_driver(now_us, bus) {
-            self.finish(op, outcome, usb);
+            self.finish(now_us, op, outcome, usb, io);
         }
         let Parts {
             settings,
@@ -128,7 +132,7 @@ impl Atom {
             }
             BusEvent::Packet(packet) => {
                 if let Some((op, outcome)) = self.schedule.on_packet(packet) {
-                    self.finish(op, outcome, usb);
+                    self.finish(now_us, op, outcome, usb, io);
                 }
             }
         }
@@ -161,22 +165,33 @@ impl Atom {
     }
 
     /// Applies the result of a finished servo transaction; sends a reply that waited for it.
-    fn finish<U: BytePort>(
+    fn finish<U: BytePort, I: AtomIo>(
         &mut self,
+        now_us: u64,
         op: crate::driver::Op,
         outcome: crate::driver::Outcome,
         usb: &mut U,
+        io: &mut I,
     ) {
         let corrupt = self.schedule.saw_corruption();
-        let done = self
-            .parts
-            .bank
-            .finish(&self.parts.settings, op, outcome, corrupt);
-        if let Some(done) = done {
-            match done.link {
-                Link::Bus => self.schedule.send_reply(done.reply),
-                Link::Usb => usb.write(&done.reply.to_bytes()),
-            }
+        let p = &mut self.parts;
+        let reply = match p.bank.finish(&p.settings, op, outcome, corrupt) {
+            Some(Completion::Reply { link, reply }) => Some((link, reply)),
+            Some(Completion::Params { index, block }) => p.backups.on_block(
+                now_us,
+                index,
+                block,
+                io.param_store(),
+                &mut p.bank,
+                &mut p.motion,
+                &p.settings,
+            ),
+            None => None,
+        };
+        match reply {
+            Some((Link::Bus, reply)) => self.schedule.send_reply(reply),
+            Some((Link::Usb, reply)) => usb.write(&reply.to_bytes()),
+            None => {}
         }
     }
 

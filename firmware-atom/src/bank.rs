@@ -24,9 +24,10 @@ mod readback;
 
 use readback::{STATE_READ_ADDR, STATE_READ_LEN, apply_state};
 
-/// Servo operations waiting for the bus. 16: a command queues at most 3 (EEPROM unlock,
-/// write, lock) or 7 (torque on/off for every servo), and the host waits for each reply.
-pub const OP_QUEUE: usize = 16;
+/// Servo operations waiting for the bus. 24: a command queues at most 3 (EEPROM unlock,
+/// write, lock), 7 (torque for every servo) or 24 (a restore of all six joints: a read, then
+/// unlock, write, lock each), and the host waits for each reply.
+pub const OP_QUEUE: usize = 24;
 
 /// A servo that stopped answering is probed only every this many refresh rounds, so a missing
 /// servo (often the gripper) does not cost its timeout in every round.
@@ -54,6 +55,8 @@ pub enum Then {
         /// True for the 2-byte form.
         two_bytes: bool,
     },
+    /// Hand the parameter block read to the backup (0xEA).
+    Backup,
 }
 
 /// A servo operation waiting for the bus.
@@ -64,13 +67,23 @@ struct Job {
     attempt: u8,
 }
 
-/// A reply that waited for a servo operation, and the link it goes to.
+/// What a finished servo operation hands on.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Completion {
-    /// Where the request came from.
-    pub link: Link,
-    /// The reply.
-    pub reply: Frame,
+pub enum Completion {
+    /// A reply that waited for the operation, and the link it goes to.
+    Reply {
+        /// Where the request came from.
+        link: Link,
+        /// The reply.
+        reply: Frame,
+    },
+    /// Servo `index`'s parameter block for a backup; `None` if it could not be read.
+    Params {
+        /// Servo index (0..6 joints, 6 gripper).
+        index: usize,
+        /// The block, registers [`crate::backup::BLOCK_ADDR`] on.
+        block: Option<crate::backup::Block>,
+    },
 }
 
 /// The servos' state and the Atom's instructions to them. See the [module doc](self).
@@ -283,9 +296,7 @@ impl ServoBank {
             }
         } else {
             // A limp servo holds no goal: nothing to compare its read-back against.
-            if let Some(last) = self.last_goal.get_mut(index) {
-                *last = None;
-            }
+            self.forget_goal(index);
             Op::write(id, reg::TORQUE_ENABLE, &[0])
                 .is_some_and(|op| self.queue_op(op, Then::Nothing))
         };
@@ -341,9 +352,16 @@ impl ServoBank {
         if let Some(h) = self.health.get_mut(index) {
             h.position = Steps(STEPS_ZERO as i16);
         }
+        self.forget_goal(index);
+    }
+
+    /// Forgets servo `index`'s goal, sent or not yet written: after a calibration or a
+    /// release it would mean another place (or move a limp servo when it is switched on).
+    fn forget_goal(&mut self, index: usize) {
         if let Some(g) = self.last_goal.get_mut(index) {
             *g = None;
         }
+        self.pending = self.pending.take().map(|p| p.without(index));
     }
 
     /// Queues a servo operation. `false` if the queue is full.
@@ -474,6 +492,16 @@ impl ServoBank {
             }
         }
         let job = self.jobs.pop_front()?;
+        if job.then == Then::Backup {
+            let block = match &outcome {
+                Outcome::Answered(p) => p.params().try_into().ok(),
+                _ => None,
+            };
+            return Some(Completion::Params {
+                index: index?,
+                block,
+            });
+        }
         let Then::ReplyServoData { link, two_bytes } = job.then else {
             return None;
         };
@@ -487,7 +515,7 @@ impl ServoBank {
         } else {
             Frame::new(cmd::GET_SERVO_DATA, &[value as u8])
         }?;
-        Some(Completion { link, reply })
+        Some(Completion::Reply { link, reply })
     }
 
     /// Takes over what servo `index` is doing when the Atom hears it for the first time and

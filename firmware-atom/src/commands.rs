@@ -99,6 +99,7 @@ fn execute<I: AtomIo>(
         motion,
         gripper,
         errors,
+        ..
     } = p;
     match request {
         // --- status and system ---
@@ -406,8 +407,17 @@ fn execute<I: AtomIo>(
             }
         }))),
         R::GetServoTemps => Answer::Now(Reply::Bytes6(per_joint(p, |h| h.temperature_c))),
-        // Servo parameters live in the servos' own EEPROM; there is nothing to back up.
-        R::BackupServoParams { .. } | R::RestoreServoParams { .. } => done(),
+        R::BackupServoParams { servo } | R::RestoreServoParams { servo } => {
+            let restore = matches!(request, R::RestoreServoParams { .. });
+            let has_store = io.param_store().is_some();
+            match p
+                .backups
+                .start(restore, servo, link, has_store, &mut p.bank, &p.settings)
+            {
+                Ok(()) => Answer::Later,
+                Err(e) => Answer::Done(Err(e)),
+            }
+        }
 
         // --- Atom IO, LED, gripper ---
         R::SetPinMode { pin, mode } => {

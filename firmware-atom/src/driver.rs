@@ -13,8 +13,9 @@ use protocol_core::timing::{BUS_BAUD, SERVO_TURNAROUND_MAX_US, wire_time_us};
 
 use protocol_core::listener::Listener;
 
-/// Most data bytes one WRITE carries: the 7-byte move block is the largest the Atom writes.
-pub const MAX_WRITE: usize = 8;
+/// Most data bytes one WRITE carries: the parameter block a restore writes (registers 9..=39,
+/// 31 bytes) is the largest the Atom writes.
+pub const MAX_WRITE: usize = 32;
 
 /// One servo transaction.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -57,11 +57,19 @@ pub trait AtomIo {
     fn set_rgb(&mut self, red: u8, green: u8, blue: u8);
     /// True while the Atom's button (GPIO39, active low) is held down.
     fn button_pressed(&mut self) -> bool;
+    /// The flash store of servo parameter backups (0xEA/0xEB); `None` if the board has none.
+    fn param_store(&mut self) -> Option<&mut dyn crate::backup::ParamStore> {
+        None
+    }
 }
 
+/// Flash of the parameter backups in [`RecordingIo`]: four 4 KiB pages.
+pub type MemParams = crate::backup::FlashParams<flash_store::MemFlash<{ 4 * 4096 }>>;
+
 /// An [`AtomIo`] that remembers what it was told, for tests and the virtual robot: pins read
-/// back what was written (inputs read low unless set with [`RecordingIo::set_input`]).
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+/// back what was written (inputs read low unless set with [`RecordingIo::set_input`]), and
+/// parameter backups kept in flash in RAM (which outlives a reset of the Atom).
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RecordingIo {
     /// Mode of each user pin, indexed like [`INPUT_PINS`].
     pub modes: [Option<PinMode>; 5],
@@ -73,6 +81,21 @@ pub struct RecordingIo {
     pub rgb: (u8, u8, u8),
     /// Whether the button is held.
     pub button: bool,
+    /// The servo parameter backups' flash.
+    pub params: MemParams,
+}
+
+impl Default for RecordingIo {
+    fn default() -> Self {
+        Self {
+            modes: Default::default(),
+            levels: Default::default(),
+            pwm: Default::default(),
+            rgb: Default::default(),
+            button: false,
+            params: MemParams::new(flash_store::MemFlash::new(), 0..4 * 4096),
+        }
+    }
 }
 
 impl RecordingIo {
@@ -137,5 +160,9 @@ impl AtomIo for RecordingIo {
 
     fn button_pressed(&mut self) -> bool {
         self.button
+    }
+
+    fn param_store(&mut self) -> Option<&mut dyn crate::backup::ParamStore> {
+        Some(&mut self.params)
     }
 }

@@ -50,6 +50,7 @@
 #![forbid(unsafe_code)]
 
 mod atom;
+pub mod backup;
 mod bank;
 pub mod cartesian;
 mod commands;

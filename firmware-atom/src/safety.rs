@@ -47,6 +47,15 @@ impl SafeGoals {
         &self.0
     }
 
+    /// The same goals without servo `index`'s (still checked: a goal less is never unsafe).
+    #[must_use]
+    pub fn without(mut self, index: usize) -> Self {
+        if let Some(slot) = self.0.get_mut(index) {
+            *slot = None;
+        }
+        self
+    }
+
     /// One WRITE at the torque-enable register (40) switching servo `index` (bus id `id`) on
     /// together with its move block (41..47): the servo holds the checked goal from the moment
     /// its torque is on, whatever stale goal its register held.

@@ -5,6 +5,7 @@
 mod support;
 
 use protocol_core::Frame;
+use protocol_core::servo::reg;
 use sim_hw::Faults;
 use sim_hw::servo::{AMBIENT_C, OVERHEAT_C};
 use support::rig::{Rig, be};
@@ -791,4 +792,74 @@ fn an_atom_restarted_mid_move_lets_the_move_finish_and_keeps_the_arm_powered() {
     assert_eq!(rig.ask(0x10, &[]), [1]);
     rig.run_ms(200);
     assert!(close(&angles(&mut rig), &target, 10));
+}
+
+#[test]
+fn backup_and_restore_bring_back_a_servos_parameters_after_a_restart() {
+    let mut rig = Rig::new();
+    assert_eq!(rig.ask(0xEB, &[2]), [0], "no backup yet: restore refused");
+    assert_eq!(rig.ask(0xEA, &[254]), [1], "backup of every joint");
+    // Someone changes joint 2's P gain and dead zone...
+    assert_eq!(rig.ask(0x52, &[2, 21, 40]), [1]);
+    assert_eq!(rig.ask(0x52, &[2, 26, 9]), [1]);
+    rig.run_ms(20);
+    assert_eq!(rig.bus.servo(2).reg(21), 40);
+    // ...the Atom restarts (its flash keeps the backups)...
+    rig.atom = firmware_atom::Atom::new(firmware_atom::AtomConfig {
+        powered_at_boot: true,
+        ..firmware_atom::AtomConfig::default()
+    });
+    rig.run_ms(50);
+    // ...and the restore puts them back.
+    assert_eq!(rig.ask(0xEB, &[2]), [1]);
+    rig.run_ms(20);
+    assert_eq!(rig.bus.servo(2).reg(21), 10, "the factory P gain again");
+    assert_eq!(rig.bus.servo(2).reg(26), 1, "the dead zone again");
+    assert_eq!(
+        rig.bus.servo(2).reg(reg::EEPROM_LOCK),
+        1,
+        "EEPROM locked again"
+    );
+    assert!(
+        rig.bus.servo(2).torque_enabled(),
+        "same zero: still holding"
+    );
+}
+
+#[test]
+fn a_restore_that_moves_a_zero_releases_the_servo_instead_of_letting_it_jump() {
+    let mut rig = Rig::new();
+    let mut data = be(&[0, 0, 3000, 0, 0, 0]);
+    data.push(100);
+    assert_eq!(rig.ask(SEND_ANGLES, &data), [1]);
+    rig.run_ms(2000);
+    assert_eq!(rig.ask(0xEA, &[3]), [1]);
+    // Calibrating at 30 degrees moves joint 3's zero there (and nothing moves).
+    let before = rig.bus.servo(3).physical_steps();
+    assert_eq!(rig.ask(0x54, &[3]), [1]);
+    rig.run_ms(300);
+    assert!(
+        (rig.bus.servo(3).physical_steps() - before).abs() < 1.0,
+        "calibration moved the joint"
+    );
+    let shifted = rig.bus.servo(3).reg_u16(reg::HOMING_OFFSET);
+    assert_ne!(shifted, 0);
+    let shaft = rig.bus.servo(3).physical_steps();
+    assert_eq!(rig.ask(0xEB, &[3]), [1]);
+    rig.run_ms(300);
+    assert_eq!(
+        rig.bus.servo(3).reg_u16(reg::HOMING_OFFSET),
+        0,
+        "the old zero is back"
+    );
+    assert!(!rig.bus.servo(3).torque_enabled(), "released, not jumping");
+    assert!(
+        (rig.bus.servo(3).physical_steps() - shaft).abs() < 1.0,
+        "the shaft stayed put"
+    );
+    let angle = angles(&mut rig)[2];
+    assert!(
+        (angle - 3000).abs() <= 10,
+        "reads 30 degrees again: {angle}"
+    );
 }

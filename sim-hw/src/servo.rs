@@ -286,6 +286,12 @@ impl SimServo {
         self.raw_position_steps - f64::from(self.homing_offset())
     }
 
+    /// Where the shaft physically is, in steps: unlike every register, independent of the
+    /// homing offset (a calibration changes what the servo reports, not where it is).
+    pub fn physical_steps(&self) -> f64 {
+        self.raw_position_steps
+    }
+
     /// The goal position register, in steps.
     pub fn goal_position(&self) -> u16 {
         self.reg_u16(reg::GOAL_POSITION)

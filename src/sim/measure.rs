@@ -27,9 +27,14 @@ pub fn flange(q_deg: &[f64; 6]) -> FlangePose {
     let a = [0.0, mm(g.a2_um), mm(g.a3_um), 0.0, 0.0, 0.0];
     let mut rotation = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     let mut position = [0.0; 3];
-    for i in 0..6 {
-        let theta = (q_deg[i] + f64::from(g.theta_offset_centideg[i]) / 100.0).to_radians();
-        let alpha = ALPHA_DEG[i].to_radians();
+    let links = q_deg
+        .iter()
+        .zip(g.theta_offset_centideg)
+        .zip(ALPHA_DEG)
+        .zip(d.iter().zip(a));
+    for (((q, offset), alpha), (d, a)) in links {
+        let theta = (q + f64::from(offset) / 100.0).to_radians();
+        let alpha = alpha.to_radians();
         let (st, ct, sa, ca) = (theta.sin(), theta.cos(), alpha.sin(), alpha.cos());
         // Standard DH: Rz(theta) Tz(d) Tx(a) Rx(alpha).
         let link_r = [
@@ -37,11 +42,8 @@ pub fn flange(q_deg: &[f64; 6]) -> FlangePose {
             [st, ct * ca, -ct * sa],
             [0.0, sa, ca],
         ];
-        let link_p = [a[i] * ct, a[i] * st, d[i]];
-        let moved = apply(&rotation, &link_p);
-        for k in 0..3 {
-            position[k] += moved[k];
-        }
+        let moved = apply(&rotation, &[a * ct, a * st, *d]);
+        position = add(&position, &moved);
         rotation = mul(&rotation, &link_r);
     }
     FlangePose {
@@ -60,35 +62,48 @@ pub fn distance_to_segment_mm(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
     } else {
         0.0
     };
-    let closest = [a[0] + ab[0] * t, a[1] + ab[1] * t, a[2] + ab[2] * t];
+    let closest = add(a, &ab.map(|v| v * t));
     norm(&sub(p, &closest))
 }
 
 /// Angle in degrees between two orientations.
 pub fn angle_between_deg(r1: &Rotation, r2: &Rotation) -> f64 {
-    let mut trace = 0.0;
-    for i in 0..3 {
-        for k in 0..3 {
-            trace += r1[k][i] * r2[k][i];
-        }
-    }
+    // trace(r1^T r2): the sum of the element-wise products.
+    let trace: f64 = r1
+        .iter()
+        .flatten()
+        .zip(r2.iter().flatten())
+        .map(|(a, b)| a * b)
+        .sum();
     ((trace - 1.0) / 2.0).clamp(-1.0, 1.0).acos().to_degrees()
 }
 
+fn column(m: &Rotation, c: usize) -> [f64; 3] {
+    m.map(|row| row.get(c).copied().unwrap_or(0.0))
+}
+
 fn mul(x: &Rotation, y: &Rotation) -> Rotation {
-    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| x[r][k] * y[k][c]).sum()))
+    x.map(|row| std::array::from_fn(|c| dot(&row, &column(y, c))))
 }
 
 fn apply(r: &Rotation, v: &[f64; 3]) -> [f64; 3] {
-    std::array::from_fn(|i| (0..3).map(|k| r[i][k] * v[k]).sum())
+    r.map(|row| dot(&row, v))
+}
+
+fn add(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    let mut sum = *a;
+    for (s, v) in sum.iter_mut().zip(b) {
+        *s += v;
+    }
+    sum
 }
 
 fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+    add(a, &b.map(|v| -v))
 }
 
 fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn norm(a: &[f64; 3]) -> f64 {

@@ -66,3 +66,16 @@ class InverseKinematicsTest(RobotTestCase):
         self.assertNotIsInstance(answer, list, f"solve_inv_kinematics -> {answer!r}")
         self.assertEqual(answer, 0)
         self.assertEqual(self.mc.get_error_information(), 32)
+
+
+class BackupTest(RobotTestCase):
+    def test_restore_brings_back_the_parameters_of_a_backup(self):
+        self.assertEqual(self.mc.backup_servo_params(4), 1)
+        original = self.mc.get_servo_data(4, 21)
+        self.assertEqual(self.mc.set_servo_data(4, 21, original + 7), 1)
+        time.sleep(0.1)
+        self.assertEqual(self.mc.get_servo_data(4, 21), original + 7)
+        self.assertEqual(self.mc.restore_servo_params(4), 1)
+        time.sleep(0.1)
+        self.assertEqual(self.mc.get_servo_data(4, 21), original, "the backed-up P gain is back")
+        self.assertEqual(self.mc.is_servo_enable(4), 1, "the servo still holds")

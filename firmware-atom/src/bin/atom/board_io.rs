@@ -9,6 +9,8 @@ use esp_hal::{
     },
     time::Rate,
 };
+use esp_storage::FlashStorage;
+use firmware_atom::backup::{FlashParams, ParamStore};
 use firmware_atom::io::{AtomIo, OUTPUT_PINS, PinMode};
 
 use crate::{
@@ -18,6 +20,10 @@ use crate::{
 
 /// Protocol number of the button pin, readable like a user input (`firmware_atom::io`).
 const BUTTON_PIN: u8 = 39;
+
+/// Where the servo parameter backups live: the `nvs` partition of the default partition table
+/// espflash writes (0x9000, 24 KiB, six 4 KiB sectors); the firmware does not use ESP-IDF's NVS.
+const PARAMS_FLASH: core::ops::Range<u32> = 0x9000..0xF000;
 
 /// One user pin: its GPIO and the LEDC timer, channel and signal reserved for its PWM.
 pub struct UserPin<'d> {
@@ -35,6 +41,8 @@ pub struct UserPin<'d> {
 pub struct BoardIo<'d> {
     /// The user pins, in the order of [`OUTPUT_PINS`].
     user: [UserPin<'d>; 4],
+    /// The servo parameter backups (0xEA/0xEB) in the Atom's flash.
+    params: FlashParams<FlashStorage<'d>>,
     /// Which user pins currently output PWM.
     pwm_on: [bool; 4],
     leds: Option<Leds<'d>>,
@@ -44,12 +52,18 @@ pub struct BoardIo<'d> {
 impl<'d> BoardIo<'d> {
     /// Takes the user pins (ordered like [`OUTPUT_PINS`]), the LEDs (if the RMT could drive
     /// them) and the button. User pins start as floating inputs, as after reset.
-    pub fn new(mut user: [UserPin<'d>; 4], leds: Option<Leds<'d>>, button: Input<'d>) -> Self {
+    pub fn new(
+        mut user: [UserPin<'d>; 4],
+        leds: Option<Leds<'d>>,
+        button: Input<'d>,
+        flash: FlashStorage<'d>,
+    ) -> Self {
         for pin in &mut user {
             make_input(&mut pin.gpio, Pull::None);
         }
         Self {
             user,
+            params: FlashParams::new(flash, PARAMS_FLASH),
             pwm_on: [false; 4],
             leds,
             button,
@@ -156,5 +170,9 @@ impl AtomIo for BoardIo<'_> {
 
     fn button_pressed(&mut self) -> bool {
         self.button.is_low()
+    }
+
+    fn param_store(&mut self) -> Option<&mut dyn ParamStore> {
+        Some(&mut self.params)
     }
 }

@@ -85,7 +85,8 @@ fn main() -> ! {
         board_log!("RMT refused the LED channel; LEDs stay dark");
     }
     let button = Input::new(pins.button, InputConfig::default().with_pull(Pull::None));
-    let mut io = BoardIo::new(user, leds, button);
+    let flash = esp_storage::FlashStorage::new(p.FLASH);
+    let mut io = BoardIo::new(user, leds, button, flash);
 
     let mut atom = Atom::new(AtomConfig::default());
     if let Some(error) = atom.config_error() {

@@ -1,0 +1,268 @@
+//! Backup and restore of each servo's parameters (0xEA / 0xEB) in the Atom's flash.
+//!
+//! A backup reads the servo's EEPROM block, registers [`BLOCK_ADDR`] ..
+//! `BLOCK_ADDR + BLOCK_LEN` (9..=39: angle limits, temperature, voltage and torque limits,
+//! PID, start-up force, dead zones, protection settings, homing offset, operating mode, speed
+//! loop gains: what a replaced or corrupted servo needs), and stores it under the servo's id in
+//! a wear-levelled flash store ([`ParamStore`], `flash_store` on the board and in the virtual
+//! robot). It survives a power cycle. The reply comes when every block is read and stored: `01`,
+//! or `00` if a servo did not answer or the flash failed.
+//!
+//! A restore writes a stored block back (EEPROM unlocked and locked around it), after the same
+//! checks as any raw write: never the id, baud rate, return delay or status return level (they
+//! are not in the block), only a block in position mode (operating mode 0), never without a
+//! backup (`00`). The homing offset is part of the block; if restoring it moves the joint's
+//! zero, the servo is released first (holding its old goal in the new frame would make it jump)
+//! and stays released until powered on or focused again, which holds it where it is. The
+//! joint limits still apply to every goal afterwards.
+
+use core::ops::Range;
+
+use embedded_storage::nor_flash::NorFlash;
+use flash_store::{FlashStore, StoreError};
+use protocol_core::Frame;
+use protocol_core::command::{ServoSelect, cmd};
+use protocol_core::servo::reg;
+
+use crate::bank::{ServoBank, Then};
+use crate::config::{JOINTS, SERVOS};
+use crate::driver::Op;
+use crate::error::AtomError;
+use crate::link::Link;
+use crate::motion::MotionController;
+use crate::settings::Settings;
+
+/// First register of the parameter block.
+pub const BLOCK_ADDR: u8 = reg::MIN_POSITION;
+/// Length of the parameter block: registers 9..=39.
+pub const BLOCK_LEN: usize = 31;
+
+/// One servo's parameter block.
+pub type Block = [u8; BLOCK_LEN];
+
+/// Offset of the homing offset (registers 31..=32) in a block.
+const HOMING_OFFSET_AT: usize = (reg::HOMING_OFFSET - BLOCK_ADDR) as usize;
+/// Offset of the operating mode (register 33) in a block.
+const MODE_AT: usize = (reg::OPERATING_MODE - BLOCK_ADDR) as usize;
+
+/// Where servo parameter blocks are kept, keyed by servo id.
+pub trait ParamStore {
+    /// The block stored for servo `id`, if any.
+    fn load(&mut self, id: u8) -> Result<Option<Block>, StoreError>;
+    /// Stores `block` for servo `id`, replacing an older one.
+    fn save(&mut self, id: u8, block: &Block) -> Result<(), StoreError>;
+}
+
+/// Servo parameter blocks in a range of NOR flash, through [`FlashStore`] (wear-levelled,
+/// power-fail safe). The board binds it to the Atom's flash (esp-storage), the virtual robot
+/// and the tests to [`flash_store::MemFlash`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FlashParams<F> {
+    flash: Option<F>,
+    range: Range<u32>,
+}
+
+impl<F: NorFlash> FlashParams<F> {
+    /// Blocks kept in `range` of `flash` (whole erase pages, at least two).
+    pub fn new(flash: F, range: Range<u32>) -> Self {
+        Self {
+            flash: Some(flash),
+            range,
+        }
+    }
+
+    /// The flash, for a look at what is stored (tests, saving the virtual robot's flash).
+    pub fn flash(&self) -> Option<&F> {
+        self.flash.as_ref()
+    }
+
+    fn with_store<T>(
+        &mut self,
+        act: impl FnOnce(&mut FlashStore<F>) -> Result<T, StoreError>,
+    ) -> Result<T, StoreError> {
+        let flash = self.flash.take().ok_or(StoreError::Flash)?;
+        let mut store = FlashStore::new(flash, self.range.clone())?;
+        let result = act(&mut store);
+        self.flash = Some(store.into_flash());
+        result
+    }
+}
+
+impl<F: NorFlash> ParamStore for FlashParams<F> {
+    fn load(&mut self, id: u8) -> Result<Option<Block>, StoreError> {
+        self.with_store(|store| {
+            let mut block = [0u8; BLOCK_LEN];
+            match store.fetch(id, &mut block)? {
+                Some(BLOCK_LEN) => Ok(Some(block)),
+                Some(_) => Err(StoreError::Corrupted),
+                None => Ok(None),
+            }
+        })
+    }
+
+    fn save(&mut self, id: u8, block: &Block) -> Result<(), StoreError> {
+        self.with_store(|store| store.store(id, block))
+    }
+}
+
+/// What the running backup or restore is waiting for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Job {
+    Backup,
+    Restore,
+}
+
+/// A backup or restore waiting for the servos' blocks to be read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Pending {
+    job: Job,
+    link: Link,
+    /// Servos (bit per index) still to be read.
+    waiting: u8,
+    ok: bool,
+}
+
+/// The backup and restore of servo parameters. See the [module doc](self).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Backups {
+    pending: Option<Pending>,
+}
+
+impl Backups {
+    /// Starts a backup (0xEA) or restore (0xEB) of `servos` for a request from `link`: reads
+    /// each servo's present block; the reply follows when all are in ([`Self::on_block`]).
+    /// Refused while another one runs, or with no store (`has_store`).
+    pub fn start(
+        &mut self,
+        restore: bool,
+        servos: ServoSelect,
+        link: Link,
+        has_store: bool,
+        bank: &mut ServoBank,
+        settings: &Settings,
+    ) -> Result<(), AtomError> {
+        if !has_store {
+            return Err(AtomError::Invalid);
+        }
+        if self.pending.is_some() {
+            return Err(AtomError::Busy);
+        }
+        let indices = match servos {
+            ServoSelect::All => 0..JOINTS,
+            ServoSelect::One(s) => {
+                let i = usize::from(s.get()) - 1;
+                i..i + 1
+            }
+        };
+        // A restore writes three operations per servo afterwards.
+        if bank.op_room() < indices.len() * 4 {
+            return Err(AtomError::Busy);
+        }
+        let mut waiting = 0u8;
+        for i in indices {
+            let id = *settings
+                .config()
+                .servo_ids
+                .get(i)
+                .ok_or(AtomError::Invalid)?;
+            let read = Op::Read {
+                id,
+                addr: BLOCK_ADDR,
+                count: BLOCK_LEN as u8,
+            };
+            if !bank.queue_op(read, Then::Backup) {
+                return Err(AtomError::Busy);
+            }
+            waiting |= 1 << i;
+        }
+        self.pending = Some(Pending {
+            job: if restore { Job::Restore } else { Job::Backup },
+            link,
+            waiting,
+            ok: true,
+        });
+        Ok(())
+    }
+
+    /// Takes servo `index`'s present block (`None`: it did not answer). A backup stores it; a
+    /// restore writes the stored one back. Returns the reply once every servo is done.
+    #[allow(clippy::too_many_arguments)]
+    pub fn on_block(
+        &mut self,
+        now_us: u64,
+        index: usize,
+        present: Option<Block>,
+        store: Option<&mut dyn ParamStore>,
+        bank: &mut ServoBank,
+        motion: &mut MotionController,
+        settings: &Settings,
+    ) -> Option<(Link, Frame)> {
+        let pending = self.pending.as_mut()?;
+        if index >= SERVOS || pending.waiting & (1 << index) == 0 {
+            return None;
+        }
+        pending.waiting &= !(1 << index);
+        let id = settings.config().servo_ids.get(index).copied();
+        let done = match (present, store, id) {
+            (Some(block), Some(store), Some(id)) => match pending.job {
+                Job::Backup => store.save(id, &block).is_ok(),
+                Job::Restore => match store.load(id) {
+                    Ok(Some(saved)) => {
+                        restore(now_us, index, id, &block, &saved, bank, motion, settings)
+                    }
+                    _ => false,
+                },
+            },
+            _ => false,
+        };
+        pending.ok &= done;
+        if pending.waiting != 0 {
+            return None;
+        }
+        let finished = self.pending.take()?;
+        let code = if finished.job == Job::Backup {
+            cmd::BACKUP_SERVO_PARAMS
+        } else {
+            cmd::RESTORE_SERVO_PARAMS
+        };
+        Some((finished.link, Frame::new(code, &[u8::from(finished.ok)])?))
+    }
+}
+
+/// Writes `saved` back to servo `index` (bus id `id`) whose block is `present` now. See the
+/// [module doc](self).
+#[allow(clippy::too_many_arguments)]
+fn restore(
+    now_us: u64,
+    index: usize,
+    id: u8,
+    present: &Block,
+    saved: &Block,
+    bank: &mut ServoBank,
+    motion: &mut MotionController,
+    settings: &Settings,
+) -> bool {
+    if saved.get(MODE_AT) != Some(&0) {
+        return false;
+    }
+    let offset = HOMING_OFFSET_AT..HOMING_OFFSET_AT + 2;
+    if present.get(offset.clone()) != saved.get(offset) {
+        // The zero moves: the servo would jump to its old goal in the new frame.
+        if index < JOINTS {
+            motion.halt(now_us, bank, settings);
+        }
+        if !bank.set_torque(settings, index, false) {
+            return false;
+        }
+    }
+    let ops = [
+        Op::write(id, reg::EEPROM_LOCK, &[0]),
+        Op::write(id, BLOCK_ADDR, saved),
+        Op::write(id, reg::EEPROM_LOCK, &[1]),
+    ];
+    if bank.op_room() < ops.len() {
+        return false;
+    }
+    ops.into_iter()
+        .all(|op| op.is_some_and(|op| bank.queue_op(op, Then::Nothing)))
+}
