@@ -112,6 +112,19 @@ pub(crate) enum Event {
     Unsolicited,
 }
 
+impl Event {
+    /// Who asked for the request this event is about, if it is about one.
+    pub(crate) fn origin(&self) -> Option<Origin> {
+        match self {
+            Self::Reply { request, .. }
+            | Self::Timeout(request)
+            | Self::GaveUp(request)
+            | Self::Expired(request) => Some(request.origin),
+            Self::Collision | Self::Unsolicited => None,
+        }
+    }
+}
+
 #[derive(Debug)]
 enum Stage {
     /// Waiting for the wire to be quiet (and any back-off to pass).

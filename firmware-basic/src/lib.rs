@@ -23,10 +23,12 @@
 //! * Both links are heard through `protocol_core`'s timed [`Listener`]: the host link for its
 //!   frames, the bus (one listener for framed and transparent mode) for the Atom's replies,
 //!   raw bytes, the Basic's own echo and how quiet the wire is.
-//! * At boot the Basic powers the Atom on (0x10, like the vendor transponder) and afterwards
-//!   probes it (0x12) whenever it has been silent for [`BasicConfig::probe_interval_us`]; the
-//!   replies to these internal requests never reach the host, they feed [`Basic::status`]
-//!   (what the LCD shows). Button A powers the Atom on again.
+//! * At boot the Basic makes sure the Atom is powered, like the vendor transponder, but without
+//!   its side effect: it asks (0x12) and powers on (0x10) only an Atom that says it is off, so
+//!   a move the host already started is never cut short (0x10 makes the Atom hold the arm where
+//!   it is). Afterwards it probes the Atom (0x12) whenever it has been silent for
+//!   [`BasicConfig::probe_interval_us`]; the replies to these internal requests never reach
+//!   the host, they feed [`Basic::status`] (what the LCD shows). Button A powers the Atom on.
 //!
 //! How the ports are used, for whoever implements them: the Basic reads with
 //! [`BytePort::read_byte`] until it returns `None` (at most [`BUS_READ_BUDGET`] bus and
