@@ -16,8 +16,8 @@ use protocol_core::command::cmd;
 
 use crate::config::BasicConfig;
 use crate::forwarder::{Event, Origin, Request};
-use crate::host_link::HostLink;
 use crate::io::Buttons;
+use crate::router::{Client, Delivery};
 use crate::status::{AtomLink, BasicError, BasicStatus};
 
 /// What the Basic still has to do about the Atom's power.
@@ -148,15 +148,16 @@ impl Supervisor {
     /// An internal request of the Basic's got no answer. Without probing, the boot's question
     /// is asked once.
     fn on_unanswered(&mut self, request: &Request) {
-        if !self.retries && request.origin != Origin::Host {
+        if !self.retries && !matches!(request.origin, Origin::Host(_)) {
             self.power = PowerTask::Done;
         }
     }
 
-    /// Acts on what happened to a request: a host's reply goes to `host`, an internal one's
-    /// only into the status.
-    pub(crate) fn on_event(&mut self, now_us: u64, event: Event, host: &mut HostLink) {
-        if let (Some(Origin::Host), PowerTask::Ensure { off_seen }) =
+    /// Acts on what happened to a request: returns a client's reply with the client to give it
+    /// to ([`Self::on_delivery`] then hears what became of it); an internal request's reply
+    /// goes only into the status.
+    pub(crate) fn on_event(&mut self, now_us: u64, event: Event) -> Option<(Client, Frame)> {
+        if let (Some(Origin::Host(_)), PowerTask::Ensure { off_seen }) =
             (event.origin(), &mut self.power)
         {
             // A host request went to the Atom after it said it was off (internal requests
@@ -182,15 +183,11 @@ impl Supervisor {
                     (cmd::IS_POWER_ON, &[state]) => status.atom_powered = Some(state == 1),
                     _ => {}
                 }
-                if request.origin == Origin::Host {
-                    if host.send_frame(&reply) {
-                        status.replies_forwarded = status.replies_forwarded.wrapping_add(1);
-                    } else {
-                        status.last_error = Some(BasicError::HostOverflow);
-                    }
-                }
                 if let (Origin::Probe, &[state]) = (request.origin, reply.data()) {
                     self.on_probe_answer(now_us, state == 1);
+                }
+                if let Origin::Host(client) = request.origin {
+                    return Some((client, reply));
                 }
             }
             Event::Timeout(request) => {
@@ -219,6 +216,19 @@ impl Supervisor {
                 self.status.collisions = self.status.collisions.wrapping_add(1);
             }
             Event::Unsolicited => {}
+        }
+        None
+    }
+
+    /// What became of a reply [`Self::on_event`] gave out for a client.
+    pub(crate) fn on_delivery(&mut self, delivery: Delivery) {
+        match delivery {
+            Delivery::Queued => {
+                self.status.replies_forwarded = self.status.replies_forwarded.wrapping_add(1);
+            }
+            Delivery::NoRoom => self.error(BasicError::HostOverflow),
+            // The client left while its request was on the bus.
+            Delivery::Gone => {}
         }
     }
 }
