@@ -14,8 +14,8 @@
 //! Then only a complete `FE FE` frame with the request's CMD byte counts as the reply; servo
 //! packets, other frames and late duplicates are dropped, and a request that gets no reply is
 //! given up after its deadline so the next one can go. The next request is the caller's choice
-//! (the [`crate::router`]'s turn, or the Basic's own); it is [`Forwarder::start`]ed only while
-//! the forwarder is [`Forwarder::idle`].
+//! (the [`crate::router`]'s turn, or the Basic's own), started only while the forwarder has
+//! none in flight.
 //!
 //! A reply garbled on the wire (the start of a frame heard but no valid frame, or a frame for
 //! another command) is lost for good: the Atom does not know. The Basic then sends the request again at once, instead of
