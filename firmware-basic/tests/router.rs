@@ -4,7 +4,7 @@
 mod common;
 
 use common::clients::{ASK, echo_atom, run_clients};
-use common::{Rig, frame};
+use common::{PING, PING_REPLY, Rig, frame};
 use firmware_basic::{BasicError, LinkId, LinksFull, MAX_HOST_LINKS, TransponderMode};
 use protocol_core::Frame;
 
@@ -115,10 +115,6 @@ fn the_reply_for_a_client_that_left_is_not_given_to_the_next_one() {
     );
 }
 
-/// PING servo 1, and its status reply.
-const PING: [u8; 6] = [0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB];
-const PING_REPLY: [u8; 6] = [0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC];
-
 #[test]
 fn in_transparent_mode_only_the_client_that_switched_gets_the_bus() {
     let (mut rig, net) = rig_with_clients(1);
@@ -130,14 +126,10 @@ fn in_transparent_mode_only_the_client_that_switched_gets_the_bus() {
     rig.atom = Box::new(|_| None);
 
     // The owner's raw bytes reach the bus, and the bus's reach the owner only.
-    rig.client(owner).send(&PING);
-    rig.run_us(2_000);
-    let sent: Vec<u8> = rig.wire().basic_sent.iter().map(|&(_, b)| b).collect();
+    let (sent, received) = rig.ping_servo_raw(owner);
     assert!(sent.ends_with(&PING), "{sent:02x?}");
-    let now = rig.now_ns;
-    rig.wire().inject(now + 50_000, &PING_REPLY);
-    rig.run_us(1_000);
-    assert_eq!(rig.client(owner).received(), PING_REPLY);
+    assert_eq!(received, PING_REPLY);
+    assert!(rig.client(other).received().is_empty());
 
     // Another client: its requests for the Atom are dropped unanswered, 0xC2 is refused,
     // 0xC3 tells it why, the Basic's other commands are answered.

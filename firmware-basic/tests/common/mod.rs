@@ -544,6 +544,26 @@ impl Rig {
     }
 }
 
+/// PING servo 1, a raw servo packet for transparent mode...
+pub const PING: [u8; 6] = [0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB];
+/// ...and the servo's status reply.
+pub const PING_REPLY: [u8; 6] = [0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC];
+
+impl Rig {
+    /// The client on `link` sends [`PING`] in transparent mode and the servo answers
+    /// [`PING_REPLY`] 50 us after it: returns every byte the Basic has put on the bus so far,
+    /// and what the client has received.
+    pub fn ping_servo_raw(&mut self, link: LinkId) -> (Vec<u8>, Vec<u8>) {
+        self.client(link).send(&PING);
+        self.run_us(2_000);
+        let sent = self.wire.basic_sent.iter().map(|&(_, b)| b).collect();
+        let now = self.now_ns;
+        self.wire.inject(now + 50_000, &PING_REPLY);
+        self.run_us(1_000);
+        (sent, self.client(link).received())
+    }
+}
+
 /// A frame's wire bytes.
 pub fn frame(cmd: u8, data: &[u8]) -> Vec<u8> {
     Frame::new(cmd, data).unwrap().to_bytes().to_vec()
