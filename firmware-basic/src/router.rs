@@ -319,32 +319,37 @@ impl Router {
     ) -> Option<Request> {
         for step in 0..MAX_HOST_LINKS {
             let index = (self.turn + step) % MAX_HOST_LINKS;
-            let Some(slot) = self.slots.get_mut(index) else {
+            let (Some(slot), Some(link)) = (self.slots.get_mut(index), LinkId::from_index(index))
+            else {
                 continue;
             };
-            if !slot.open || !slot.link.has_room_for_frame() {
+            if !slot.open {
                 continue;
             }
-            let Some(link) = LinkId::from_index(index) else {
-                continue;
-            };
             let client = Client {
                 link,
                 session: slot.session,
             };
+            let request = |waiting: Waiting| Request {
+                frame: waiting.frame,
+                origin: Origin::Host(client),
+                queued_us: waiting.arrived_us,
+            };
+            // Expired requests go even while the link's output is full, so they do not hold
+            // up the Basic's own requests (which wait for every link to be idle).
             let deadline_us = slot.link.kind().client_deadline_us();
-            while let Some(waiting) = slot.waiting.pop_front() {
-                let request = Request {
-                    frame: waiting.frame,
-                    origin: Origin::Host(client),
-                    queued_us: waiting.arrived_us,
-                };
-                if now_us.saturating_sub(waiting.arrived_us) > deadline_us {
-                    on_expired(request);
-                    continue;
-                }
+            while let Some(waiting) = slot
+                .waiting
+                .pop_front_if(|w| now_us.saturating_sub(w.arrived_us) > deadline_us)
+            {
+                on_expired(request(waiting));
+            }
+            if !slot.link.has_room_for_frame() {
+                continue;
+            }
+            if let Some(waiting) = slot.waiting.pop_front() {
                 self.turn = (index + 1) % MAX_HOST_LINKS;
-                return Some(request);
+                return Some(request(waiting));
             }
         }
         None
@@ -488,6 +493,30 @@ mod tests {
                 .collect();
         assert_eq!(sent, [0x20], "0.3 s for a socket, 0.5 s for USB");
         assert_eq!(expired, [0x30]);
+    }
+
+    #[test]
+    fn a_link_that_cannot_take_a_reply_waits_but_its_stale_requests_still_go() {
+        let mut router = Router::new();
+        let net = router.open(LinkKind::Network).unwrap();
+        // The client does not read: its output queue is nearly full.
+        assert!(router.send_bytes(net, &[0; 500]));
+        router
+            .push(router.client(net).unwrap(), frame(0x30), 0)
+            .unwrap();
+        assert!(
+            router.next_request(1, |_| {}).is_none(),
+            "no room for its reply"
+        );
+        assert!(router.has_requests());
+        let mut expired = 0;
+        let late = LinkKind::Network.client_deadline_us() + 1;
+        assert!(router.next_request(late, |_| expired += 1).is_none());
+        assert_eq!(expired, 1);
+        assert!(
+            !router.has_requests(),
+            "the Basic's own requests are not held up"
+        );
     }
 
     #[test]
