@@ -6,24 +6,29 @@ mod sim_support;
 
 use open_mycobot::sim::{RobotConfig, VirtualRobot};
 use protocol_core::command::Request;
+use protocol_core::units::Centideg;
 use sim_support::*;
 
-/// The tester's move: joint 1 to 90 degrees at half speed.
-const TARGET_DEG: [f64; 6] = [90.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+/// Starts the tester's move, joint 1 to 90 degrees at half speed (answered `01`); returns its
+/// target.
+fn start_move(robot: &mut VirtualRobot) -> [Centideg; 6] {
+    let target = degrees([90.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    ack(
+        robot,
+        Request::SendAngles {
+            angles: target,
+            speed: speed(50),
+        },
+    );
+    target
+}
 
 #[test]
 fn a_move_sent_in_the_first_second_after_switch_on_runs_to_its_end() {
     for sent_at_us in [50_000, 300_000, 700_000, 950_000] {
         let mut robot = VirtualRobot::new(RobotConfig::default());
         robot.run_for(sent_at_us);
-        let target = degrees(TARGET_DEG);
-        ack(
-            &mut robot,
-            Request::SendAngles {
-                angles: target,
-                speed: speed(50),
-            },
-        );
+        let target = start_move(&mut robot);
         wait_until_stopped(&mut robot);
         assert_angles_near(
             robot.measured_angles(),
@@ -56,14 +61,7 @@ fn an_arm_that_starts_powered_off_is_powered_on_by_the_basic() {
 #[ignore = "needs the Atom change: power on (0x10) while powered keeps a running motion"]
 fn a_power_on_to_an_arm_that_is_on_does_not_cut_a_move_short() {
     let mut robot = arm();
-    let target = degrees(TARGET_DEG);
-    ack(
-        &mut robot,
-        Request::SendAngles {
-            angles: target,
-            speed: speed(50),
-        },
-    );
+    let target = start_move(&mut robot);
     robot.run_for(300_000);
     ack(&mut robot, Request::PowerOn);
     wait_until_stopped(&mut robot);
