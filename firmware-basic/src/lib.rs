@@ -192,7 +192,9 @@ impl Basic {
                     .on_time(now_us, bus, &mut self.bus, &self.config, |e| {
                         deliver(now_us, e, supervisor, router)
                     });
-                let idle = self.forwarder.idle() && !self.router.has_requests();
+                // The Basic's own requests only on a framed bus nobody else is using.
+                let idle =
+                    mode == Mode::Framed && self.forwarder.idle() && !self.router.has_requests();
                 let internal = self
                     .supervisor
                     .next_internal(now_us, &self.config, buttons, idle);
