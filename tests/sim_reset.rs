@@ -5,6 +5,7 @@
 mod sim_support;
 
 use protocol_core::command::{Reply, Request};
+use protocol_core::units::Centideg;
 use sim_support::*;
 
 const POSE_DEG: [f64; 6] = [25.0, -35.0, 45.0, -20.0, 30.0, -60.0];
@@ -68,4 +69,46 @@ fn the_basic_restarts_and_the_host_gets_answers_again() {
         "get_angles after the restart",
     );
     assert_eq!(ask(&mut robot, Request::IsPowerOn), Reply::Byte(1));
+}
+
+/// Runs until no shaft has moved for half a second (at most the motion timeout); returns the
+/// angles there. Asks the host link nothing.
+fn wait_for_shafts_to_settle(robot: &mut open_mycobot::sim::VirtualRobot) -> [Centideg; 6] {
+    let deadline = robot.now_us() + MOTION_TIMEOUT_US;
+    let mut last = robot.measured_angles();
+    let mut still_since = robot.now_us();
+    while robot.now_us() - still_since < 500_000 {
+        assert!(robot.now_us() < deadline, "still moving after the timeout");
+        robot.run_for(20_000);
+        let now = robot.measured_angles();
+        if now != last {
+            last = now;
+            still_since = robot.now_us();
+        }
+    }
+    last
+}
+
+#[test]
+fn the_basic_restarting_mid_move_neither_stops_nor_moves_the_arm() {
+    for restart_after_us in [100_000, 400_000, 900_000] {
+        let mut robot = arm();
+        let target = degrees([90.0, -30.0, 40.0, 0.0, 20.0, 0.0]);
+        ack(
+            &mut robot,
+            Request::SendAngles {
+                angles: target,
+                speed: speed(40),
+            },
+        );
+        robot.run_for(restart_after_us);
+        robot.reset_basic();
+        // The host stays away while the Basic boots (it cannot be heard anyway).
+        let settled = wait_for_shafts_to_settle(&mut robot);
+        let context = format!("Basic restarted {restart_after_us} us into the move");
+        assert_angles_near(settled, target, &context);
+        robot.run_for(3_000_000);
+        assert_eq!(robot.measured_angles(), settled, "{context}: moved unasked");
+        assert_angles_near(get_angles(&mut robot), target, &context);
+    }
 }

@@ -19,13 +19,15 @@ pub struct BasicConfig {
     pub probe_timeout_us: u64,
     /// Transmissions of one request before it is given up after collisions (at least 1).
     pub max_send_attempts: u8,
-    /// Time after power-up before the Basic powers the Atom on (0x10), in microseconds; the
-    /// Atom boots in parallel and must be listening.
+    /// Time after power-up before the Basic makes sure the Atom is powered (asks with 0x12,
+    /// then 0x10 if it is off), in microseconds; the Atom boots in parallel and must be
+    /// listening.
     pub boot_power_on_delay_us: u64,
     /// With no answer from the Atom for this long while idle, the Basic probes it (0x12), in
     /// microseconds; 0 disables probing (and the boot power-on retries).
     pub probe_interval_us: u64,
-    /// Whether to send 0x10 (power on) to the Atom at boot, like the vendor transponder.
+    /// Whether to make sure the Atom is powered at boot, like the vendor transponder: unlike
+    /// it, the Basic asks first (0x12) and sends power on (0x10) only to an Atom that is off.
     pub power_on_at_boot: bool,
     /// The version the Basic reports for 0xC1, times ten (10 = "1.0").
     pub version_x10: u8,

@@ -13,31 +13,23 @@
 //! so it is retransmitted only if repeating the request is harmless.
 //! Then only a complete `FE FE` frame with the request's CMD byte counts as the reply; servo
 //! packets, other frames and late duplicates are dropped, and a request that gets no reply is
-//! given up after its deadline so the next one can go. Requests wait in a bounded queue
-//! meanwhile.
+//! given up after its deadline so the next one can go. The next request is the caller's choice
+//! (the [`crate::router`]'s turn, or the Basic's own), started only while the forwarder has
+//! none in flight.
 //!
 //! A reply garbled on the wire (the start of a frame heard but no valid frame, or a frame for
 //! another command) is lost for good: the Atom does not know. The Basic then sends the request again at once, instead of
 //! leaving the host to wait 0.5 s and resend it itself - unless repeating it could move the
 //! arm twice ([`is_repeatable`]: the incremental jogs 0x33 and 0x34).
 
-use heapless::{Deque, Vec};
+use heapless::Vec;
 use protocol_core::command::cmd;
 use protocol_core::frame::{HEADER, MAX_FRAME_BYTES};
 use protocol_core::listener::{Echo, Heard, Listener};
 use protocol_core::{BytePort, Frame, timing};
 
 use crate::config::BasicConfig;
-
-/// Requests that may wait behind the one in flight. pymycobot sends one request at a time
-/// and waits for its reply; 32 absorbs a client that pipelines a burst (a request arrives
-/// every 0.43 ms at 115200, an exchange with the Atom takes about 1 ms). Staleness is bounded
-/// by [`MAX_QUEUED_US`], not by the depth.
-pub const REQUEST_QUEUE_DEPTH: usize = 32;
-/// A request that has waited in the queue this long is dropped unsent, in microseconds: the
-/// client has given up on it (pymycobot resends after 0.5 s) and a command that old must not
-/// move the arm.
-pub const MAX_QUEUED_US: u64 = timing::HOST_REPLY_DEADLINE_US;
+use crate::router::Client;
 /// Bytes received further apart than this had silence between them (a new transmission
 /// began), in microseconds: one byte time and the reaction time.
 const BURST_GAP_US: u64 = timing::wire_time_us(1, timing::BUS_BAUD) + REACTION_US;
@@ -78,8 +70,8 @@ pub fn is_repeatable(request: &Frame) -> bool {
 /// Who asked for a request, and so where its reply goes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Origin {
-    /// The host: the reply goes to the host.
-    Host,
+    /// A client on a host link: the reply goes to that client.
+    Host(Client),
     /// The Basic's boot power-on (0x10): the reply is consumed.
     PowerOn,
     /// The Basic's liveness probe (0x12): the reply is consumed.
@@ -91,7 +83,7 @@ pub(crate) enum Origin {
 pub(crate) struct Request {
     pub(crate) frame: Frame,
     pub(crate) origin: Origin,
-    /// When it was queued.
+    /// When it arrived (or was made), in microseconds.
     pub(crate) queued_us: u64,
 }
 
@@ -104,12 +96,26 @@ pub(crate) enum Event {
     Timeout(Request),
     /// `request` collided on every attempt and was given up.
     GaveUp(Request),
-    /// `request` waited in the queue longer than [`MAX_QUEUED_US`] and was dropped unsent.
+    /// `request` waited for its turn longer than its client waits for a reply, and was
+    /// dropped unsent.
     Expired(Request),
     /// A transmission collided and will be repeated.
     Collision,
     /// A frame from the bus answered nothing outstanding and was dropped.
     Unsolicited,
+}
+
+impl Event {
+    /// Who asked for the request this event is about, if it is about one.
+    pub(crate) fn origin(&self) -> Option<Origin> {
+        match self {
+            Self::Reply { request, .. }
+            | Self::Timeout(request)
+            | Self::GaveUp(request)
+            | Self::Expired(request) => Some(request.origin),
+            Self::Collision | Self::Unsolicited => None,
+        }
+    }
 }
 
 #[derive(Debug)]
@@ -143,32 +149,37 @@ struct InFlight {
 /// The bus forwarder.
 #[derive(Debug)]
 pub(crate) struct Forwarder {
-    queue: Deque<Request, REQUEST_QUEUE_DEPTH>,
     current: Option<InFlight>,
 }
 
 impl Forwarder {
     pub(crate) const fn new() -> Self {
-        Self {
-            queue: Deque::new(),
-            current: None,
+        Self { current: None }
+    }
+
+    /// True when no request is in flight: the next may start.
+    pub(crate) fn idle(&self) -> bool {
+        self.current.is_none()
+    }
+
+    /// Takes `request` in flight; it goes onto the wire as soon as the wire allows. Call only
+    /// while [`Self::idle`]; a request in flight is never replaced.
+    pub(crate) fn start(&mut self, request: Request) {
+        if self.current.is_some() {
+            return;
         }
-    }
-
-    /// True while a request is in flight or queued.
-    pub(crate) fn busy(&self) -> bool {
-        self.current.is_some() || !self.queue.is_empty()
-    }
-
-    /// Queues a request; gives it back if the queue is full.
-    pub(crate) fn enqueue(&mut self, request: Request) -> Result<(), Request> {
-        self.queue.push_back(request)
-    }
-
-    /// Drops every queued and in-flight request (mode change).
-    pub(crate) fn clear(&mut self) {
-        self.queue.clear();
-        self.current = None;
+        let mut wire = Vec::new();
+        let mut buf = [0u8; MAX_FRAME_BYTES];
+        if let Some(bytes) = request.frame.encode(&mut buf).and_then(|n| buf.get(..n)) {
+            // Cannot fail: a frame's encoding fits MAX_FRAME_BYTES.
+            let _ = wire.extend_from_slice(bytes);
+        }
+        self.current = Some(InFlight {
+            request,
+            wire,
+            attempts: 0,
+            stage: Stage::WaitQuiet { not_before_us: 0 },
+        });
     }
 
     /// Handles one byte heard on the bus at `now_us`, passing it through `listener`.
@@ -264,18 +275,15 @@ impl Forwarder {
     }
 
     /// Lets time pass in `listener` (echo verdicts, frames cut short), checks deadlines and
-    /// the transmitter; starts the next transmission when the wire allows. Call after the bytes
-    /// that arrived have been passed to [`Self::on_bus_byte`]. `room_for_reply` is false while
-    /// the host link could not take another reply: the next request then waits in the queue (a
-    /// reply is often longer than its request, so a client that pipelines requests would
-    /// otherwise overrun the host link).
-    pub(crate) fn poll<B: BytePort>(
+    /// the transmitter. Call after the bytes that arrived have been passed to
+    /// [`Self::on_bus_byte`]; then [`Self::start`] the next request if idle, then
+    /// [`Self::try_send`].
+    pub(crate) fn on_time<B: BytePort>(
         &mut self,
         now_us: u64,
-        bus: &mut B,
+        bus: &B,
         listener: &mut Listener,
         config: &BasicConfig,
-        room_for_reply: bool,
         mut on_event: impl FnMut(Event),
     ) {
         let silence_before = listener.quiet_us(now_us) > BURST_GAP_US;
@@ -302,28 +310,6 @@ impl Forwarder {
         {
             on_event(Event::Timeout(done.request));
         }
-        while self.current.is_none()
-            && room_for_reply
-            && let Some(request) = self.queue.pop_front()
-        {
-            if now_us.saturating_sub(request.queued_us) > MAX_QUEUED_US {
-                on_event(Event::Expired(request));
-                continue;
-            }
-            let mut wire = Vec::new();
-            let mut buf = [0u8; MAX_FRAME_BYTES];
-            if let Some(bytes) = request.frame.encode(&mut buf).and_then(|n| buf.get(..n)) {
-                // Cannot fail: a frame's encoding fits MAX_FRAME_BYTES.
-                let _ = wire.extend_from_slice(bytes);
-            }
-            self.current = Some(InFlight {
-                request,
-                wire,
-                attempts: 0,
-                stage: Stage::WaitQuiet { not_before_us: 0 },
-            });
-        }
-        self.try_send(now_us, bus, listener);
     }
 
     fn on_collision(
@@ -354,7 +340,7 @@ impl Forwarder {
     fn start_waiting(&mut self, now_us: u64, config: &BasicConfig) {
         if let Some(flight) = &mut self.current {
             let timeout_us = match flight.request.origin {
-                Origin::Host => config.reply_timeout_us,
+                Origin::Host(_) => config.reply_timeout_us,
                 Origin::PowerOn | Origin::Probe => config.probe_timeout_us,
             };
             flight.stage = Stage::AwaitReply {
@@ -367,7 +353,12 @@ impl Forwarder {
     }
 
     /// Transmits the request in flight if the wire is free.
-    fn try_send<B: BytePort>(&mut self, now_us: u64, bus: &mut B, listener: &mut Listener) {
+    pub(crate) fn try_send<B: BytePort>(
+        &mut self,
+        now_us: u64,
+        bus: &mut B,
+        listener: &mut Listener,
+    ) {
         let quiet_us = listener.quiet_us(now_us);
         let Some(flight) = &mut self.current else {
             return;

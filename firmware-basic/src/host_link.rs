@@ -1,26 +1,71 @@
-//! The host side of the transponder: hears the host's byte stream through a [`Listener`] (host
-//! frames only, and the host link's quiet gap for truncated frames) and queues bytes for the
-//! host without ever blocking the loop.
+//! One host link of the transponder (the USB serial, or one network client): hears the
+//! client's byte stream through its own [`Listener`] (host frames only, and the link's own quiet
+//! gap for truncated frames) and queues bytes for the client without ever blocking the loop.
 
 use heapless::{Deque, Vec};
 use protocol_core::frame::{MAX_FRAME_BYTES, MIN_LEN};
 use protocol_core::listener::{Heard, Listener, ListenerConfig};
-use protocol_core::{BytePort, Frame, timing};
+use protocol_core::{Frame, timing};
 
-/// Bytes waiting for the host link: 44 ms of 115200. In framed mode the forwarder starts a
-/// request only while a reply of any size still fits, so replies are never dropped; in
+/// Bytes waiting for each host link: 44 ms of 115200. In framed mode a link's next request
+/// goes to the Atom only while a reply of any size still fits, so replies are never dropped; in
 /// transparent mode a busy bus (1 Mbaud) outpaces the host link and the oldest bytes go.
 pub const HOST_TX_CAPACITY: usize = 512;
 /// Most bytes handed to the host port in one write: well under the ESP32 UART's 128-byte FIFO,
 /// so a write into an idle transmitter never waits.
 pub const HOST_WRITE_CHUNK: usize = 64;
-/// Most host bytes taken per poll, so one poll stays short whatever the host sends.
+/// Most bytes taken from one host link per poll, so one poll stays short whatever the clients
+/// send.
 pub const HOST_READ_BUDGET: usize = 64;
 
-/// How the Basic hears its host link: host frames only, cut short by the host link's gap.
-const HOST_LISTENER: ListenerConfig = ListenerConfig::new()
-    .with_packets(false)
-    .with_frame_gap_us(timing::HOST_FRAME_GAP_US);
+/// Silence inside a frame from a network client (TCP over Wi-Fi) after which the frame was cut
+/// short, in microseconds. A client writes a frame in one `send`, which arrives in one segment
+/// as a rule; a segment split by the network may come a few milliseconds late, and a half frame
+/// of garbage only ever delays its own client's next request, so the gap is generous.
+pub const NETWORK_FRAME_GAP_US: u64 = 20_000;
+
+/// How long pymycobot's socket client waits for a reply before it sends again, in microseconds
+/// (`MyCobot280Socket`: 0.3 s per try; the serial client waits 0.5 s).
+pub const NETWORK_REPLY_DEADLINE_US: u64 = 300_000;
+
+/// What a host link is, which sets its timing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LinkKind {
+    /// A serial line at 115200 baud (the USB serial): a frame cut by a quiet gap of
+    /// [`timing::HOST_FRAME_GAP_US`] is dropped; the client resends after 0.5 s.
+    Serial,
+    /// A network client (TCP): a frame cut by a quiet gap of [`NETWORK_FRAME_GAP_US`] is
+    /// dropped; the client resends after [`NETWORK_REPLY_DEADLINE_US`].
+    Network,
+}
+
+impl LinkKind {
+    /// Silence after which a partial frame from this link was cut short, in microseconds.
+    pub const fn frame_gap_us(self) -> u64 {
+        match self {
+            Self::Serial => timing::HOST_FRAME_GAP_US,
+            Self::Network => NETWORK_FRAME_GAP_US,
+        }
+    }
+
+    /// How long this link's client waits for a reply before it sends the request again, in
+    /// microseconds. A request that has waited this long for its turn is dropped unsent: its
+    /// client has given up on it, and a command that old must not move the arm (nor its late
+    /// reply be taken for the answer to the client's next request).
+    pub const fn client_deadline_us(self) -> u64 {
+        match self {
+            Self::Serial => timing::HOST_REPLY_DEADLINE_US,
+            Self::Network => NETWORK_REPLY_DEADLINE_US,
+        }
+    }
+
+    /// How the Basic hears a link of this kind: host frames only, cut short by its gap.
+    const fn listener(self) -> ListenerConfig {
+        ListenerConfig::new()
+            .with_packets(false)
+            .with_frame_gap_us(self.frame_gap_us())
+    }
+}
 
 /// Most frames one host byte (or one quiet gap) can complete: the framer holds at most
 /// [`MAX_FRAME_BYTES`] bytes, and a frame takes at least `3 + MIN_LEN` of them.
@@ -29,32 +74,34 @@ pub const MAX_FRAMES_AT_ONCE: usize = MAX_FRAME_BYTES / (3 + MIN_LEN as usize);
 /// The frames one host byte or one quiet gap completed, in order.
 pub(crate) type HostFrames = Vec<Frame, MAX_FRAMES_AT_ONCE>;
 
-/// The host link: a listener for what arrives and a bounded queue for what leaves.
+/// A host link: a listener for what arrives and a bounded queue for what leaves.
 #[derive(Debug)]
 pub(crate) struct HostLink {
+    kind: LinkKind,
     rx: Listener,
     tx: Deque<u8, HOST_TX_CAPACITY>,
 }
 
 impl HostLink {
-    pub(crate) const fn new() -> Self {
+    /// A link of `kind` that has heard and sent nothing.
+    pub(crate) const fn new(kind: LinkKind) -> Self {
         Self {
-            rx: Listener::new(HOST_LISTENER),
+            kind,
+            rx: Listener::new(kind.listener()),
             tx: Deque::new(),
         }
     }
 
-    /// Takes one byte from the host at `now_us`; the frames it completes go into `frames`.
-    pub(crate) fn read_byte<H: BytePort>(
-        &mut self,
-        now_us: u64,
-        host: &mut H,
-        frames: &mut HostFrames,
-    ) -> Option<u8> {
-        let byte = host.read_byte()?;
+    /// What the link is.
+    pub(crate) fn kind(&self) -> LinkKind {
+        self.kind
+    }
+
+    /// Takes one byte `byte` from the client at `now_us`; the frames it completes go into
+    /// `frames`.
+    pub(crate) fn hear(&mut self, now_us: u64, byte: u8, frames: &mut HostFrames) {
         self.rx
             .push(now_us, byte, &mut |heard| collect(heard, frames));
-        Some(byte)
     }
 
     /// Microseconds since the last host byte arrived.
@@ -62,8 +109,8 @@ impl HostLink {
         self.rx.quiet_us(now_us)
     }
 
-    /// Drops a partial frame once the host has been quiet for [`timing::HOST_FRAME_GAP_US`]
-    /// (it was cut short); real frames uncovered by the rescan go into `frames`.
+    /// Drops a partial frame once the client has been quiet for the link's gap (it was cut
+    /// short); real frames uncovered by the rescan go into `frames`.
     #[inline]
     pub(crate) fn check_gap(&mut self, now_us: u64, frames: &mut HostFrames) {
         self.rx.on_time(now_us, &mut |heard| collect(heard, frames));
@@ -115,25 +162,23 @@ impl HostLink {
         self.tx.clear();
     }
 
-    /// Hands queued bytes to the host port once its transmitter is idle.
-    pub(crate) fn flush<H: BytePort>(&mut self, host: &mut H) {
-        if self.tx.is_empty() || !host.tx_idle() {
-            return;
+    /// Takes up to [`HOST_WRITE_CHUNK`] queued bytes for the port, once its transmitter is
+    /// `idle`; `None` if there is nothing to hand over now.
+    pub(crate) fn next_chunk(&mut self, idle: bool) -> Option<Vec<u8, HOST_WRITE_CHUNK>> {
+        if self.tx.is_empty() || !idle {
+            return None;
         }
-        let mut chunk = [0u8; HOST_WRITE_CHUNK];
-        let mut n = 0;
-        for slot in chunk.iter_mut() {
+        let mut chunk = Vec::new();
+        while !chunk.is_full() {
             match self.tx.pop_front() {
+                // Cannot fail: the chunk is not full.
                 Some(b) => {
-                    *slot = b;
-                    n += 1;
+                    let _ = chunk.push(b);
                 }
                 None => break,
             }
         }
-        if let Some(bytes) = chunk.get(..n) {
-            host.write(bytes);
-        }
+        Some(chunk)
     }
 }
 

@@ -1,41 +1,55 @@
-//! The myCobot 280 M5 Basic firmware: the transponder between the host's USB serial (115200)
-//! and the arm's shared 1 Mbaud bus, as a host-tested library of poll-driven state machines.
+//! The myCobot 280 M5 Basic firmware: the transponder between the host's links (the USB serial
+//! at 115200, and network clients) and the arm's shared 1 Mbaud bus, as a host-tested library
+//! of poll-driven state machines.
 //!
-//! The Basic makes the arm feel like one device: every host request reaches the Atom once,
-//! every reply reaches the host once, and nothing else leaks (servo packets, its own echo,
-//! replies to its internal requests). The board layer (esp-hal binary) and the virtual robot
-//! bind [`BasicIo`] and two [`BytePort`]s and call [`Basic::poll`] in a tight loop.
+//! The Basic makes the arm feel like one device to each client: every request reaches the Atom
+//! once, its reply reaches the client that asked once, and nothing else leaks (servo packets,
+//! its own echo, replies to its internal requests or to other clients). The board layer
+//! (esp-hal binary) and the virtual robot bind [`BasicIo`], the bus [`BytePort`] and the host
+//! links ([`HostPorts`]; a single UART is one) and call [`Basic::poll`] in a tight loop.
 //!
-//! * [`local`]: the commands the Basic answers itself (0xA0, 0xA1, 0xB0..0xB2, 0xC0..0xC3),
-//!   at once, even while the Atom is silent or a flood fills the queue. The Basic has no Wi-Fi:
-//!   0xB0/0xB2 are refused with `00`, 0xB1 reports empty credentials in the text form
-//!   pymycobot parses.
+//! * [`router`]: the host links, each with its own framer, request queue and output queue; the
+//!   USB link is always open, network clients come and go ([`Basic::open_link`],
+//!   [`Basic::close_link`], at most [`MAX_HOST_LINKS`]). The bus serves the links round robin,
+//!   and each reply goes to the client that asked.
+//! * [`local`]: the commands the Basic answers itself (0xA0, 0xA1, 0xB0..0xB2, 0xC0..0xC3), at
+//!   once, to the client that asked, even while the Atom is silent or a flood fills a queue.
+//!   The Basic has no Wi-Fi: 0xB0/0xB2 are refused with `00`, 0xB1 reports empty credentials
+//!   in the text form pymycobot parses.
 //! * [`forwarder`]: everything else goes onto the bus, one request at a time, into a quiet
 //!   wire, echo checked (heard or not: [`EchoMode::Auto`] finds out on the first send),
 //!   collisions and garbled replies retried; only the reply with the request's CMD comes back,
 //!   and a request the Atom does not answer is given up after
 //!   [`BasicConfig::reply_timeout_us`] (below pymycobot's 0.5 s resend).
-//! * [`transparent`]: after `0xC2 01` raw bytes go both ways (the Basic's echo removed),
-//!   until the host sends exactly `FE FE 03 C2 00 FA`; only that and the exact mode frames
-//!   `FE FE 03 C2 01 FA` and `FE FE 02 C3 FA` are still answered by the Basic then.
-//! * [`host_link`]: framing of the host stream (a frame cut by a 2 ms gap is dropped) and a
+//! * [`transparent`]: after `0xC2 01` raw bytes go both ways (the Basic's echo removed)
+//!   between the bus and the client that switched, until it sends exactly
+//!   `FE FE 03 C2 00 FA` (or leaves); only that and the exact mode frames `FE FE 03 C2 01 FA`
+//!   and `FE FE 02 C3 FA` are still answered by the Basic then. The other clients are still
+//!   heard in framed mode: the Basic's own commands are answered (0xC3 says transparent),
+//!   0xC2 is refused with `00`, and requests for the Atom are dropped unanswered (any answer
+//!   the Basic made up could be read as a value). The switch waits for the request on the bus
+//!   to be answered; requests still waiting are dropped.
+//! * [`host_link`]: one link's framing (a frame cut by its link's quiet gap is dropped) and a
 //!   bounded output queue written only into an idle transmitter, so `poll` never blocks.
-//! * Both links are heard through `protocol_core`'s timed [`Listener`]: the host link for its
+//! * Every link is heard through `protocol_core`'s timed [`Listener`]: each host link for its
 //!   frames, the bus (one listener for framed and transparent mode) for the Atom's replies,
 //!   raw bytes, the Basic's own echo and how quiet the wire is.
-//! * At boot the Basic powers the Atom on (0x10, like the vendor transponder) and afterwards
-//!   probes it (0x12) whenever it has been silent for [`BasicConfig::probe_interval_us`]; the
-//!   replies to these internal requests never reach the host, they feed [`Basic::status`]
-//!   (what the LCD shows). Button A powers the Atom on again.
+//! * At boot the Basic makes sure the Atom is powered, like the vendor transponder, but without
+//!   its side effect: it asks (0x12) and powers on (0x10) only an Atom that says it is off, so
+//!   a move the host already started is never cut short (0x10 makes the Atom hold the arm where
+//!   it is). Afterwards it probes the Atom (0x12) whenever it has been silent for
+//!   [`BasicConfig::probe_interval_us`]; the replies to these internal requests never reach
+//!   a client, they feed [`Basic::status`] (what the LCD shows). Button A powers the Atom on.
 //!
 //! How the ports are used, for whoever implements them: the Basic reads with
-//! [`BytePort::read_byte`] until it returns `None` (at most [`BUS_READ_BUDGET`] bus and
-//! [`host_link::HOST_READ_BUDGET`] host bytes per poll), and writes only into an idle
-//! transmitter ([`BytePort::tx_idle`]), at most 67 bytes to the bus and 64 to the host at a
-//! time, so a write never waits on a 128-byte UART FIFO. Timing comes only from `now_us`.
+//! [`BytePort::read_byte`] / [`HostPorts::read_from`] until it returns `None` (at most
+//! [`BUS_READ_BUDGET`] bus and [`host_link::HOST_READ_BUDGET`] bytes per host link per poll),
+//! and writes only into an idle transmitter, at most 67 bytes to the bus and 64 to a host link
+//! at a time, so a write never waits on a 128-byte UART FIFO. Timing comes only from `now_us`.
 //!
 //! Latency (bench `latency`, virtual time): the Basic adds one poll period to each direction
-//! on an idle wire, beyond the frame's own wire time.
+//! on an idle wire, beyond the frame's own wire time. Several clients (bench `router`): no
+//! reply crossed or lost, the bus shared round robin.
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 
@@ -44,19 +58,23 @@ pub mod forwarder;
 pub mod host_link;
 pub mod io;
 pub mod local;
+pub mod router;
 pub mod status;
 mod supervisor;
 pub mod transparent;
 
 pub use config::{BasicConfig, ConfigError, EchoMode};
+pub use host_link::LinkKind;
 pub use io::{BasicIo, Buttons, NullIo};
+pub use router::{HostPorts, LinkId, LinksFull, MAX_HOST_LINKS};
 pub use status::{AtomLink, BasicError, BasicStatus, TransponderMode};
 
-use forwarder::{Forwarder, Origin, Request};
-use host_link::{HOST_READ_BUDGET, HostFrames, HostLink};
-use protocol_core::command::{Reply, cmd};
+use forwarder::{Event, Forwarder};
+use host_link::{HOST_READ_BUDGET, HostFrames};
+use protocol_core::command::{Reply, cmd, is_basic_local};
 use protocol_core::listener::{Listener, ListenerConfig};
 use protocol_core::{BytePort, Frame};
+use router::Router;
 use supervisor::Supervisor;
 use transparent::{Intercepted, Transparent};
 
@@ -76,12 +94,22 @@ fn bus_listener(echo: EchoMode) -> Listener {
     )
 }
 
+/// What the bus carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mode {
+    /// Host frames, one request at a time, for every link.
+    Framed,
+    /// Raw bytes between the bus and `owner`, the link that switched (once the request that
+    /// was on the bus then has been answered).
+    Transparent { owner: LinkId },
+}
+
 /// The Basic's transponder: one per board, polled forever.
 #[derive(Debug)]
 pub struct Basic {
     config: BasicConfig,
-    mode: TransponderMode,
-    host: HostLink,
+    mode: Mode,
+    router: Router,
     /// The bus as the Basic hears it, lent to the forwarder or the transparent pipe.
     bus: Listener,
     forwarder: Forwarder,
@@ -92,13 +120,14 @@ pub struct Basic {
 }
 
 impl Basic {
-    /// A transponder that has just been powered up. `config` should have passed
-    /// [`BasicConfig::validate`]; an invalid one still never panics (0 send attempts act as 1).
+    /// A transponder that has just been powered up, with only its USB link open. `config`
+    /// should have passed [`BasicConfig::validate`]; an invalid one still never panics (0 send
+    /// attempts act as 1).
     pub fn new(config: BasicConfig) -> Self {
         Self {
             config,
-            mode: TransponderMode::Framed,
-            host: HostLink::new(),
+            mode: Mode::Framed,
+            router: Router::new(),
             bus: bus_listener(config.echo),
             forwarder: Forwarder::new(),
             transparent: Transparent::default(),
@@ -107,13 +136,37 @@ impl Basic {
         }
     }
 
+    /// Opens a host link for a new client of `kind` (a TCP connection: [`LinkKind::Network`]),
+    /// with its own framer, queue and turn on the bus. [`LinksFull`] if [`MAX_HOST_LINKS`]
+    /// links are open: the transport turns the client away.
+    pub fn open_link(&mut self, kind: LinkKind) -> Result<LinkId, LinksFull> {
+        self.router.open(kind)
+    }
+
+    /// Closes `link`, whose client has gone: its partial frame, waiting requests and queued
+    /// output are dropped, and the reply to its request on the bus (if any) will be too. If it
+    /// had switched the bus to transparent mode, the bus is framed again. Closing the USB link
+    /// (always open) starts it afresh.
+    pub fn close_link(&mut self, link: LinkId) {
+        self.router.close(link);
+        if self.mode == (Mode::Transparent { owner: link }) {
+            self.leave_transparent();
+        }
+    }
+
+    /// True if `link` is open.
+    pub fn link_open(&self, link: LinkId) -> bool {
+        self.router.is_open(link)
+    }
+
     /// Does all pending work at time `now_us` (monotonic microseconds): reads what arrived on
-    /// the host link and the bus, answers or forwards, checks deadlines. Never blocks; call it
-    /// often (every few microseconds of bus time) and whenever bytes arrive.
-    pub fn poll<H: BytePort, B: BytePort, I: BasicIo>(
+    /// the host links and the bus, answers or forwards, checks deadlines. Never blocks; call it
+    /// often (every few microseconds of bus time) and whenever bytes arrive. `hosts` are the
+    /// host links' ports: a single [`BytePort`] is the USB link alone.
+    pub fn poll<H: HostPorts, B: BytePort, I: BasicIo>(
         &mut self,
         now_us: u64,
-        host: &mut H,
+        hosts: &mut H,
         bus: &mut B,
         io: &mut I,
     ) {
@@ -124,42 +177,52 @@ impl Basic {
             self.supervisor.boot(now_us, &self.config);
         }
         self.read_bus(now_us, bus);
-        self.read_host(now_us, host, io);
+        self.read_hosts(now_us, hosts, io);
+        let buttons = io.buttons();
         match self.mode {
-            TransponderMode::Framed => {
-                let idle = !self.forwarder.busy();
-                if let Some(request) =
-                    self.supervisor
-                        .next_internal(now_us, &self.config, io.buttons(), idle)
-                {
-                    // Cannot fail: the queue is empty.
-                    let _ = self.forwarder.enqueue(request);
-                }
-                let room_for_reply = self.host.has_room_for_frame();
-                let (supervisor, link) = (&mut self.supervisor, &mut self.host);
-                self.forwarder.poll(
-                    now_us,
-                    bus,
-                    &mut self.bus,
-                    &self.config,
-                    room_for_reply,
-                    |e| supervisor.on_event(now_us, e, link),
-                );
-            }
-            TransponderMode::Transparent => {
-                let (supervisor, link) = (&mut self.supervisor, &mut self.host);
+            Mode::Transparent { owner } if self.forwarder.idle() => {
+                let (supervisor, router) = (&mut self.supervisor, &mut self.router);
                 self.transparent.poll(now_us, bus, &mut self.bus, |b| {
-                    send_raw(link, supervisor, b)
+                    send_raw(router, owner, supervisor, b)
                 });
             }
+            mode => {
+                let (supervisor, router) = (&mut self.supervisor, &mut self.router);
+                self.forwarder
+                    .on_time(now_us, bus, &mut self.bus, &self.config, |e| {
+                        deliver(now_us, e, supervisor, router)
+                    });
+                // The Basic's own requests only on a framed bus nobody else is using.
+                let idle =
+                    mode == Mode::Framed && self.forwarder.idle() && !self.router.has_requests();
+                let internal = self
+                    .supervisor
+                    .next_internal(now_us, &self.config, buttons, idle);
+                if mode == Mode::Framed && self.forwarder.idle() {
+                    let (supervisor, router) = (&mut self.supervisor, &mut self.router);
+                    let next = internal.or_else(|| {
+                        // An expired request has no reply to give.
+                        router.next_request(now_us, |expired| {
+                            let _ = supervisor.on_event(now_us, Event::Expired(expired));
+                        })
+                    });
+                    if let Some(request) = next {
+                        self.forwarder.start(request);
+                    }
+                }
+                self.forwarder.try_send(now_us, bus, &mut self.bus);
+            }
         }
-        self.host.flush(host);
+        self.router.flush(hosts);
     }
 
     /// What the LCD shows.
     pub fn status(&self) -> BasicStatus {
         BasicStatus {
-            mode: self.mode,
+            mode: match self.mode {
+                Mode::Framed => TransponderMode::Framed,
+                Mode::Transparent { .. } => TransponderMode::Transparent,
+            },
             echo_heard: self.bus.echo_heard(),
             transparent_dropped: self.transparent.dropped,
             ..self.supervisor.status
@@ -171,75 +234,100 @@ impl Basic {
             let Some(byte) = bus.read_byte() else {
                 break;
             };
-            let (supervisor, link) = (&mut self.supervisor, &mut self.host);
+            let (supervisor, router) = (&mut self.supervisor, &mut self.router);
             match self.mode {
-                TransponderMode::Framed => {
-                    self.forwarder
-                        .on_bus_byte(now_us, byte, &mut self.bus, &self.config, |e| {
-                            supervisor.on_event(now_us, e, link)
-                        });
-                }
-                TransponderMode::Transparent => {
+                Mode::Transparent { owner } if self.forwarder.idle() => {
                     Transparent::bus_byte(now_us, byte, &mut self.bus, |b| {
-                        send_raw(link, supervisor, b)
+                        send_raw(router, owner, supervisor, b)
                     });
                 }
+                _ => {
+                    self.forwarder
+                        .on_bus_byte(now_us, byte, &mut self.bus, &self.config, |e| {
+                            deliver(now_us, e, supervisor, router)
+                        });
+                }
             }
         }
     }
 
-    fn read_host<H: BytePort, I: BasicIo>(&mut self, now_us: u64, host: &mut H, io: &mut I) {
+    fn read_hosts<H: HostPorts, I: BasicIo>(&mut self, now_us: u64, hosts: &mut H, io: &mut I) {
+        for link in self.router.open_links() {
+            self.read_host(now_us, hosts, link, io);
+        }
+    }
+
+    /// Reads what arrived on `link` (at most [`HOST_READ_BUDGET`] bytes) and acts on it.
+    fn read_host<H: HostPorts, I: BasicIo>(
+        &mut self,
+        now_us: u64,
+        hosts: &mut H,
+        link: LinkId,
+        io: &mut I,
+    ) {
         for _ in 0..HOST_READ_BUDGET {
             let mut frames = HostFrames::new();
-            let Some(byte) = self.host.read_byte(now_us, host, &mut frames) else {
+            let Some(byte) = self.router.read_byte(now_us, hosts, link, &mut frames) else {
                 break;
             };
-            match self.mode {
-                TransponderMode::Framed => {
-                    for frame in frames.drain(..) {
-                        self.on_host_frame(now_us, frame, io);
-                    }
+            if self.is_owner(link) {
+                if let Some(hit) = self.transparent.host_byte(byte) {
+                    self.on_intercepted(link, hit);
                 }
-                TransponderMode::Transparent => {
-                    if let Some(hit) = self.transparent.host_byte(byte) {
-                        self.on_intercepted(hit);
-                    }
+            } else {
+                for frame in frames.drain(..) {
+                    self.on_host_frame(now_us, link, frame, io);
                 }
             }
         }
-        match self.mode {
-            TransponderMode::Framed => {
-                let mut frames = HostFrames::new();
-                self.host.check_gap(now_us, &mut frames);
-                if !frames.is_empty() {
-                    for frame in frames.drain(..) {
-                        self.on_host_frame(now_us, frame, io);
-                    }
-                }
-            }
-            TransponderMode::Transparent => {
-                self.transparent.host_quiet(self.host.quiet_for_us(now_us));
+        if self.is_owner(link) {
+            let quiet_us = self.router.quiet_for_us(now_us, link);
+            self.transparent.host_quiet(quiet_us);
+        } else {
+            let mut frames = HostFrames::new();
+            self.router.check_gap(now_us, link, &mut frames);
+            for frame in frames.drain(..) {
+                self.on_host_frame(now_us, link, frame, io);
             }
         }
     }
 
-    fn on_host_frame<I: BasicIo>(&mut self, now_us: u64, frame: Frame, io: &mut I) {
-        if self.mode == TransponderMode::Transparent {
+    /// True if `link` switched the bus to transparent mode: its bytes are raw.
+    fn is_owner(&self, link: LinkId) -> bool {
+        self.mode == (Mode::Transparent { owner: link })
+    }
+
+    fn on_host_frame<I: BasicIo>(&mut self, now_us: u64, link: LinkId, frame: Frame, io: &mut I) {
+        if self.is_owner(link) {
             // A frame completed by the same byte as the one that entered transparent mode:
             // it is raw data now.
             for &b in frame.to_bytes().iter() {
                 if let Some(hit) = self.transparent.host_byte(b) {
-                    self.on_intercepted(hit);
+                    self.on_intercepted(link, hit);
                 }
             }
             return;
         }
-        let cmd = frame.cmd();
-        self.supervisor.on_host_request(cmd);
-        if let Some(answer) = local::answer(&frame, io, self.config.version_x10, self.mode) {
+        let code = frame.cmd();
+        if let Mode::Transparent { .. } = self.mode {
+            // The bus is another client's: the Basic's own commands are still answered (0xC3
+            // says why the rest is not), 0xC2 is that client's to send.
+            if code == cmd::SET_TRANSPONDER_MODE {
+                self.send_frame(link, &Reply::Byte(0).to_frame(code));
+                return;
+            }
+            if !is_basic_local(code) {
+                self.supervisor
+                    .error(BasicError::TransparentElsewhere { cmd: code });
+                return;
+            }
+        }
+        self.supervisor.on_host_request(code);
+        let mode = self.status().mode;
+        if let Some(answer) = local::answer(&frame, io, self.config.version_x10, mode) {
             let sent = match &answer.reply {
-                local::Reply::Frame(reply) => self.host.send_frame(reply),
-                local::Reply::Raw(bytes) => self.host.send_bytes(bytes),
+                local::Reply::Frame(reply) => self.router.send_frame(link, reply),
+                local::Reply::Raw(bytes) => self.router.send_bytes(link, bytes),
             };
             if !sent {
                 self.supervisor.error(BasicError::HostOverflow);
@@ -247,38 +335,54 @@ impl Basic {
             if let Some(error) = answer.error {
                 self.supervisor.error(error);
             }
-            if answer.new_mode == Some(TransponderMode::Transparent) {
-                self.enter_transparent();
+            if answer.new_mode == Some(TransponderMode::Transparent) && self.mode == Mode::Framed {
+                self.enter_transparent(link);
             }
             return;
         }
-        let request = Request {
-            frame,
-            origin: Origin::Host,
-            queued_us: now_us,
+        let Some(client) = self.router.client(link) else {
+            return;
         };
-        if self.forwarder.enqueue(request).is_err() {
-            self.supervisor.error(BasicError::QueueFull { cmd });
+        if self.router.push(client, frame, now_us).is_err() {
+            self.supervisor.error(BasicError::QueueFull { cmd: code });
         }
     }
 
-    fn enter_transparent(&mut self) {
-        self.mode = TransponderMode::Transparent;
-        self.forwarder.clear();
-        self.bus.drop_partials();
-        self.host.reset_framer();
+    /// Queues `frame` for `link`, noting an overflow.
+    fn send_frame(&mut self, link: LinkId, frame: &Frame) {
+        if !self.router.send_frame(link, frame) {
+            self.supervisor.error(BasicError::HostOverflow);
+        }
+    }
+
+    /// `owner` switched the bus to transparent mode: requests still waiting are dropped (their
+    /// clients would get the raw bytes of the reply otherwise); the one on the bus is answered
+    /// first.
+    fn enter_transparent(&mut self, owner: LinkId) {
+        self.mode = Mode::Transparent { owner };
+        self.router.clear_requests();
+        self.router.reset_framer(owner);
         self.transparent = Transparent::default();
     }
 
-    /// Answers a frame the Basic still handles in transparent mode. Raw traffic still queued
-    /// for the host is dropped so the answer is not lost behind a backlog of bus bytes.
-    fn on_intercepted(&mut self, hit: Intercepted) {
-        self.host.clear_tx();
+    /// Back to framed mode.
+    fn leave_transparent(&mut self) {
+        if let Mode::Transparent { owner } = self.mode {
+            self.router.reset_framer(owner);
+        }
+        self.mode = Mode::Framed;
+        self.transparent = Transparent::default();
+        self.bus.drop_partials();
+    }
+
+    /// Answers a frame the Basic still handles in transparent mode, from the owner `link`.
+    /// Raw traffic still queued for it is dropped so the answer is not lost behind a backlog of
+    /// bus bytes.
+    fn on_intercepted(&mut self, link: LinkId, hit: Intercepted) {
+        self.router.clear_tx(link);
         let reply = match hit {
             Intercepted::SetFramed => {
-                self.mode = TransponderMode::Framed;
-                self.host.reset_framer();
-                self.transparent = Transparent::default();
+                self.leave_transparent();
                 Reply::Ack.to_frame(cmd::SET_TRANSPONDER_MODE)
             }
             Intercepted::SetTransparent => Reply::Ack.to_frame(cmd::SET_TRANSPONDER_MODE),
@@ -286,15 +390,20 @@ impl Basic {
                 Reply::Byte(TransponderMode::Transparent as u8).to_frame(cmd::GET_TRANSPONDER_MODE)
             }
         };
-        if !self.host.send_frame(&reply) {
-            self.supervisor.error(BasicError::HostOverflow);
-        }
+        self.send_frame(link, &reply);
     }
 }
 
-/// Queues one raw byte for the host, noting an overflow.
-fn send_raw(host: &mut HostLink, supervisor: &mut Supervisor, byte: u8) {
-    if !host.send_raw(byte) {
+/// Acts on what happened to a request: status for the display, a reply for its client.
+fn deliver(now_us: u64, event: Event, supervisor: &mut Supervisor, router: &mut Router) {
+    if let Some((client, reply)) = supervisor.on_event(now_us, event) {
+        supervisor.on_delivery(router.send_reply(client, &reply));
+    }
+}
+
+/// Queues one raw byte for `link`, noting an overflow.
+fn send_raw(router: &mut Router, link: LinkId, supervisor: &mut Supervisor, byte: u8) {
+    if !router.send_raw(link, byte) {
         supervisor.error(BasicError::HostOverflow);
     }
 }

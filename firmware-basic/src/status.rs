@@ -33,6 +33,12 @@ pub enum BasicError {
         /// The request's command byte.
         cmd: u8,
     },
+    /// Request `cmd` for the Atom was dropped unanswered: the bus is in transparent mode for
+    /// another client.
+    TransparentElsewhere {
+        /// The request's command byte.
+        cmd: u8,
+    },
     /// A 0xA0/0xA1 request named a pin the Basic does not have.
     InvalidPin {
         /// The pin number asked for.
@@ -59,9 +65,9 @@ pub struct BasicStatus {
     pub echo_heard: Option<bool>,
     /// The last thing that went wrong.
     pub last_error: Option<BasicError>,
-    /// Host frames received in framed mode (own commands and forwarded). Wraps.
+    /// Host frames received in framed mode on every link (own commands and forwarded). Wraps.
     pub host_frames: u32,
-    /// Replies from the Atom passed to the host. Wraps.
+    /// Replies from the Atom passed to the clients that asked. Wraps.
     pub replies_forwarded: u32,
     /// Requests the Atom did not answer in time. Wraps.
     pub timeouts: u32,

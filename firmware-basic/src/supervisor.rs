@@ -1,27 +1,50 @@
-//! Looks after the Atom and keeps the status the LCD shows: powers the Atom on after boot
-//! (0x10, like the vendor transponder), probes it (0x12) when it has been silent for a while,
-//! and turns the forwarder's events into replies for the host and status for the display.
+//! Looks after the Atom and keeps the status the LCD shows: makes sure the Atom is powered after
+//! boot, probes it (0x12) when it has been silent for a while, and turns the forwarder's events
+//! into replies for the host and status for the display.
+//!
+//! The boot power-on never cuts a move short. The vendor transponder sends power on (0x10) at
+//! boot, and the Atom answers 0x10 by holding the arm where it is: a move the host started in
+//! the Basic's first second (or before the Basic restarted) would stop halfway. So the Basic
+//! first asks (0x12) and sends 0x10 only if the Atom says it is off, with no host request
+//! having reached the Atom between that answer and the 0x10 (else it asks again). An Atom that is off runs no
+//! motion (it refuses moves while off), so this 0x10 stops nothing. A host power on, power off
+//! or release (0x10, 0x11, 0x13) decides the power itself, and the Basic no longer does.
+//! Button A is the user asking in person: it sends 0x10 at once.
 
 use protocol_core::Frame;
 use protocol_core::command::cmd;
 
 use crate::config::BasicConfig;
 use crate::forwarder::{Event, Origin, Request};
-use crate::host_link::HostLink;
 use crate::io::Buttons;
+use crate::router::{Client, Delivery};
 use crate::status::{AtomLink, BasicError, BasicStatus};
+
+/// What the Basic still has to do about the Atom's power.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum PowerTask {
+    /// Nothing: the Atom is on, or the host decides.
+    Done,
+    /// Make sure the Atom is on (boot): ask, and power on only if it is off. `off_seen`: it
+    /// answered off, and no host request has been forwarded since.
+    Ensure { off_seen: bool },
+    /// Power on now (button A).
+    Now,
+}
 
 /// The supervisor's state.
 #[derive(Debug)]
 pub(crate) struct Supervisor {
     pub(crate) status: BasicStatus,
-    /// A power-on (0x10) is owed to the Atom: at boot, or after button A.
-    power_on_pending: bool,
+    /// What the Basic still has to do about the Atom's power.
+    power: PowerTask,
     /// Earliest time of the next internal request.
     next_internal_us: u64,
     /// When the Atom last answered anything.
     last_answer_us: u64,
     buttons: Buttons,
+    /// Internal requests are tried again (probing is on).
+    retries: bool,
 }
 
 impl Supervisor {
@@ -31,10 +54,15 @@ impl Supervisor {
                 version_x10: config.version_x10,
                 ..BasicStatus::default()
             },
-            power_on_pending: config.power_on_at_boot,
+            power: if config.power_on_at_boot {
+                PowerTask::Ensure { off_seen: false }
+            } else {
+                PowerTask::Done
+            },
             next_internal_us: 0,
             last_answer_us: 0,
             buttons: Buttons::default(),
+            retries: config.probe_interval_us > 0,
         }
     }
 
@@ -52,9 +80,12 @@ impl Supervisor {
     /// A host frame with command `code` arrived (framed mode).
     pub(crate) fn on_host_request(&mut self, code: u8) {
         self.status.host_frames = self.status.host_frames.wrapping_add(1);
-        if matches!(code, cmd::POWER_OFF | cmd::RELEASE_ALL_SERVOS) {
+        if matches!(
+            code,
+            cmd::POWER_ON | cmd::POWER_OFF | cmd::RELEASE_ALL_SERVOS
+        ) {
             // The host has taken charge of the arm's power: do not power it on behind its back.
-            self.power_on_pending = false;
+            self.power = PowerTask::Done;
         }
     }
 
@@ -68,7 +99,7 @@ impl Supervisor {
         idle: bool,
     ) -> Option<Request> {
         if buttons.a && !self.buttons.a {
-            self.power_on_pending = true;
+            self.power = PowerTask::Now;
             self.next_internal_us = now_us;
         }
         self.buttons = buttons;
@@ -76,16 +107,21 @@ impl Supervisor {
             return None;
         }
         let interval_us = config.probe_interval_us;
-        let (cmd, origin) = if self.power_on_pending {
-            (cmd::POWER_ON, Origin::PowerOn)
-        } else if interval_us > 0 && now_us.saturating_sub(self.last_answer_us) >= interval_us {
-            (cmd::IS_POWER_ON, Origin::Probe)
-        } else {
-            return None;
+        let (cmd, origin) = match self.power {
+            PowerTask::Now | PowerTask::Ensure { off_seen: true } => {
+                (cmd::POWER_ON, Origin::PowerOn)
+            }
+            PowerTask::Ensure { off_seen: false } => (cmd::IS_POWER_ON, Origin::Probe),
+            PowerTask::Done
+                if interval_us > 0 && now_us.saturating_sub(self.last_answer_us) >= interval_us =>
+            {
+                (cmd::IS_POWER_ON, Origin::Probe)
+            }
+            PowerTask::Done => return None,
         };
-        if interval_us == 0 {
+        if !self.retries && origin == Origin::PowerOn {
             // Without probing, a power-on is tried once.
-            self.power_on_pending = false;
+            self.power = PowerTask::Done;
         }
         self.next_internal_us = now_us.saturating_add(interval_us.max(1));
         Some(Request {
@@ -96,9 +132,39 @@ impl Supervisor {
         })
     }
 
-    /// Acts on what happened to a request: a host's reply goes to `host`, an internal one's
-    /// only into the status.
-    pub(crate) fn on_event(&mut self, now_us: u64, event: Event, host: &mut HostLink) {
+    /// The Atom answered the Basic's 0x12: powered or not.
+    fn on_probe_answer(&mut self, now_us: u64, powered: bool) {
+        if let PowerTask::Ensure { off_seen } = &mut self.power {
+            if powered {
+                self.power = PowerTask::Done;
+            } else {
+                *off_seen = true;
+                // Power it on at the next idle moment, before anything else can start.
+                self.next_internal_us = now_us;
+            }
+        }
+    }
+
+    /// An internal request of the Basic's got no answer. Without probing, the boot's question
+    /// is asked once.
+    fn on_unanswered(&mut self, request: &Request) {
+        if !self.retries && !matches!(request.origin, Origin::Host(_)) {
+            self.power = PowerTask::Done;
+        }
+    }
+
+    /// Acts on what happened to a request: returns a client's reply with the client to give it
+    /// to ([`Self::on_delivery`] then hears what became of it); an internal request's reply
+    /// goes only into the status.
+    pub(crate) fn on_event(&mut self, now_us: u64, event: Event) -> Option<(Client, Frame)> {
+        if let (Some(Origin::Host(_)), PowerTask::Ensure { off_seen }) =
+            (event.origin(), &mut self.power)
+        {
+            // A host request went to the Atom after it said it was off (internal requests
+            // wait for an idle forwarder, so every such request ends here before the 0x10):
+            // it may have started something. Ask again.
+            *off_seen = false;
+        }
         let status = &mut self.status;
         match event {
             Event::Reply { request, reply } => {
@@ -109,21 +175,24 @@ impl Supervisor {
                     (cmd::POWER_ON, _) => {
                         // Answered either way: the Atom is alive and has decided.
                         status.atom_powered = Some(done);
-                        self.power_on_pending = false;
+                        if request.origin == Origin::PowerOn {
+                            self.power = PowerTask::Done;
+                        }
                     }
                     (cmd::POWER_OFF, _) if done => status.atom_powered = Some(false),
                     (cmd::IS_POWER_ON, &[state]) => status.atom_powered = Some(state == 1),
                     _ => {}
                 }
-                if request.origin == Origin::Host {
-                    if host.send_frame(&reply) {
-                        status.replies_forwarded = status.replies_forwarded.wrapping_add(1);
-                    } else {
-                        status.last_error = Some(BasicError::HostOverflow);
-                    }
+                if let (Origin::Probe, &[state]) = (request.origin, reply.data()) {
+                    self.on_probe_answer(now_us, state == 1);
+                }
+                if let Origin::Host(client) = request.origin {
+                    return Some((client, reply));
                 }
             }
             Event::Timeout(request) => {
+                self.on_unanswered(&request);
+                let status = &mut self.status;
                 status.atom = AtomLink::Silent;
                 status.timeouts = status.timeouts.wrapping_add(1);
                 status.last_error = Some(BasicError::ReplyTimeout {
@@ -131,18 +200,35 @@ impl Supervisor {
                 });
             }
             Event::GaveUp(request) => {
+                self.on_unanswered(&request);
+                let status = &mut self.status;
                 status.collisions = status.collisions.wrapping_add(1);
                 status.last_error = Some(BasicError::BusCollisions {
                     cmd: request.frame.cmd(),
                 });
             }
             Event::Expired(request) => {
-                status.last_error = Some(BasicError::QueueFull {
+                self.status.last_error = Some(BasicError::QueueFull {
                     cmd: request.frame.cmd(),
                 });
             }
-            Event::Collision => status.collisions = status.collisions.wrapping_add(1),
+            Event::Collision => {
+                self.status.collisions = self.status.collisions.wrapping_add(1);
+            }
             Event::Unsolicited => {}
+        }
+        None
+    }
+
+    /// What became of a reply [`Self::on_event`] gave out for a client.
+    pub(crate) fn on_delivery(&mut self, delivery: Delivery) {
+        match delivery {
+            Delivery::Queued => {
+                self.status.replies_forwarded = self.status.replies_forwarded.wrapping_add(1);
+            }
+            Delivery::NoRoom => self.error(BasicError::HostOverflow),
+            // The client left while its request was on the bus.
+            Delivery::Gone => {}
         }
     }
 }

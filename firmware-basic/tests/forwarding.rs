@@ -238,19 +238,82 @@ fn the_basic_waits_for_a_quiet_wire_before_sending() {
     assert_eq!(rig.host.received(), angles_reply());
 }
 
+/// An Atom that boots powered off: 0x12 answers `00` until a 0x10.
+fn atom_off_until_powered_on() -> common::Responder {
+    let mut powered = false;
+    Box::new(move |f: &Frame| {
+        powered |= f.cmd() == 0x10;
+        let data = match f.cmd() {
+            IS_POWERED_ON => u8::from(powered),
+            _ => 1,
+        };
+        Some(frame(f.cmd(), &[data]))
+    })
+}
+
 #[test]
 fn boot_powers_the_atom_on_without_telling_the_host() {
     let mut rig = Rig::new(BasicConfig::default(), true);
+    rig.atom = atom_off_until_powered_on();
     rig.step_ns = 20_000;
     rig.run_us(900_000);
     assert!(rig.atom_got.is_empty(), "the Atom is still booting");
     rig.run_us(200_000);
     let got: Vec<u8> = rig.atom_got.iter().map(|(_, f)| f.cmd()).collect();
-    assert_eq!(got, [0x10]);
+    assert_eq!(got, [IS_POWERED_ON, 0x10], "asked first, then powered on");
     let status = rig.basic.status();
     assert_eq!(status.atom, AtomLink::Answering);
     assert_eq!(status.atom_powered, Some(true));
     assert!(rig.host.received().is_empty());
+}
+
+#[test]
+fn an_atom_already_on_at_boot_is_only_asked() {
+    // 0x10 makes the Atom hold the arm where it is: sent to an Atom that is on, it would cut
+    // short a move the host started before the Basic's boot power-on.
+    let mut rig = Rig::new(BasicConfig::default(), true);
+    rig.step_ns = 20_000;
+    rig.run_us(1_100_000);
+    let got: Vec<u8> = rig.atom_got.iter().map(|(_, f)| f.cmd()).collect();
+    assert_eq!(got, [IS_POWERED_ON]);
+    assert_eq!(rig.basic.status().atom_powered, Some(true));
+    assert!(rig.host.received().is_empty());
+}
+
+#[test]
+fn a_host_request_after_the_atom_said_off_makes_the_basic_ask_again() {
+    let mut rig = Rig::new(BasicConfig::default(), true);
+    let said_off = std::rc::Rc::new(std::cell::Cell::new(false));
+    let flag = said_off.clone();
+    let mut atom = atom_off_until_powered_on();
+    rig.atom = Box::new(move |f: &Frame| {
+        flag.set(flag.get() || f.cmd() == IS_POWERED_ON);
+        atom(f)
+    });
+    rig.atom_delay_ns = 2_000_000;
+    rig.step_ns = 1_000;
+    rig.run_us(1_000_000);
+    while !said_off.get() {
+        rig.step();
+    }
+    // The host's request arrives while the Basic waits for the Atom's "off": it reaches the
+    // Atom after that answer.
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(20_000);
+    let got: Vec<u8> = rig.atom_got.iter().map(|(_, f)| f.cmd()).collect();
+    assert_eq!(got, [IS_POWERED_ON, GET_ANGLES, IS_POWERED_ON, 0x10]);
+    assert_eq!(rig.host.received(), frame(GET_ANGLES, &[1]));
+}
+
+#[test]
+fn a_host_power_on_at_boot_is_not_repeated_by_the_basic() {
+    let mut rig = Rig::new(BasicConfig::default(), true);
+    rig.atom = atom_off_until_powered_on();
+    rig.step_ns = 20_000;
+    rig.host.send(&frame(0x10, &[]));
+    rig.run_us(2_500_000);
+    let got: Vec<u8> = rig.atom_got.iter().map(|(_, f)| f.cmd()).collect();
+    assert_eq!(got.iter().filter(|&&c| c == 0x10).count(), 1, "{got:02x?}");
 }
 
 #[test]

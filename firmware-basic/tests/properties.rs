@@ -29,6 +29,12 @@ impl BytePort for ScriptPort {
     }
 }
 
+/// True if `part` is `whole` with some elements left out, the rest in order.
+fn is_subsequence(part: &[u8], whole: &[u8]) -> bool {
+    let mut rest = whole.iter();
+    part.iter().all(|p| rest.any(|w| w == p))
+}
+
 fn echo_mode() -> impl Strategy<Value = EchoMode> {
     prop_oneof![
         Just(EchoMode::Auto),
@@ -102,10 +108,20 @@ proptest! {
         prop_assert!(host.written.ends_with(&expected), "{:02x?}", host.written);
     }
 
-    /// Requests arriving in arbitrary pieces (gaps shorter than the frame gap) each reach the
-    /// Atom once, in order, and each reply reaches the host once, in order - with or without
-    /// echo, whatever the Atom's turnaround, with servo traffic (no `FE` bytes) on the bus
-    /// meanwhile.
+    /// Requests arriving in arbitrary pieces (gaps shorter than the frame gap) reach the Atom
+    /// at most once each, in order, and the host gets exactly one reply for each request the
+    /// Atom got, in order - with or without echo, whatever the Atom's turnaround, with servo
+    /// traffic (no `FE` bytes) on the bus meanwhile.
+    ///
+    /// With echo every request gets through: a collision shows in the echo and the request
+    /// is sent again. Without echo, noise that overlaps only the end of a request (it starts
+    /// during the Basic's last byte and ends after it) garbles the request at the Atom while
+    /// nothing reaches the Basic before its transmission is over, so nothing can show it the
+    /// collision: such a request is lost. The Basic then waits its reply timeout, counts the
+    /// timeout and goes on with the next request; the client sends again after its own
+    /// deadline (pymycobot: 0.5 s). So the run lasts past the reply timeout, and the
+    /// property is: no request twice, no reply without its request, every lost request
+    /// counted as a timeout, and the next request afterwards answered.
     #[test]
     fn one_reply_per_request_under_any_chunking(
         cmds in prop::collection::vec(
@@ -138,6 +154,12 @@ proptest! {
         }
         rig.host.send(rest);
         rig.run_us(60_000 + bytes.len() as u64 * HOST_BYTE_NS / 1_000);
+        if rig.host_frames().len() < cmds.len() {
+            // A request was lost: let the Basic's reply timeout pass (at a coarser poll,
+            // only to save test time) and the requests behind it go.
+            rig.step_ns = 10_000;
+            rig.run_us(BasicConfig::default().reply_timeout_us + 20_000);
+        }
         let replied: Vec<u8> = rig.host_frames().iter().map(Frame::cmd).collect();
         // A collision with the noise corrupts a copy: the Atom cannot decode it, or (host
         // frames carry no checksum) decodes another command, which no request matches. It
@@ -148,7 +170,17 @@ proptest! {
             .map(|(_, f)| f.cmd())
             .filter(|c| cmds.contains(c))
             .collect();
-        prop_assert_eq!(&delivered, &cmds);
-        prop_assert_eq!(&replied, &cmds);
+        prop_assert!(is_subsequence(&delivered, &cmds), "{:02x?} of {:02x?}", delivered, cmds);
+        prop_assert_eq!(&replied, &delivered);
+        let lost = cmds.len() - delivered.len();
+        if echo {
+            prop_assert_eq!(lost, 0, "with echo every collision shows");
+        }
+        prop_assert_eq!(rig.basic.status().timeouts as usize, lost);
+        // Not wedged: the client's next request is answered.
+        rig.step_ns = 2_000;
+        rig.host.send(&frame(0x12, &[]));
+        rig.run_us(10_000);
+        prop_assert_eq!(rig.host_frames().len(), delivered.len() + 1);
     }
 }

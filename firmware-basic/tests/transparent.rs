@@ -3,12 +3,8 @@
 
 mod common;
 
-use common::{BUS_BYTE_NS, Rig, frame};
-use firmware_basic::TransponderMode;
-
-/// PING servo 1, and its status reply.
-const PING: [u8; 6] = [0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB];
-const PING_REPLY: [u8; 6] = [0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC];
+use common::{BUS_BYTE_NS, PING, PING_REPLY, Rig, frame};
+use firmware_basic::{LinkId, TransponderMode};
 
 fn enter(rig: &mut Rig) {
     rig.host.send(&frame(0xC2, &[1]));
@@ -28,14 +24,9 @@ fn raw_servo_traffic_passes_both_ways_without_the_echo() {
         rig.host.from_basic.clear();
         enter(&mut rig);
         rig.atom = Box::new(|_| None);
-        rig.host.send(&PING);
-        rig.run_us(2_000);
-        let sent: Vec<u8> = rig.wire().basic_sent.iter().map(|&(_, b)| b).collect();
+        let (sent, received) = rig.ping_servo_raw(LinkId::USB);
         assert!(sent.ends_with(&PING), "echo {echo}: {sent:02x?}");
-        let now = rig.now_ns;
-        rig.wire().inject(now + 50_000, &PING_REPLY);
-        rig.run_us(1_000);
-        assert_eq!(rig.host.received(), PING_REPLY, "echo {echo}");
+        assert_eq!(received, PING_REPLY, "echo {echo}");
     }
 }
 

@@ -2,7 +2,10 @@
 //!
 //! One loop, no threads: wait for a client's bytes (`ppoll`, so input wakes it at once) or the
 //! next tick, advance the robot's virtual time to the wall clock, hand it the input, and pass
-//! what the robot sent back to the client that spoke last. While clients are talking the tick
+//! what the robot sent back to its clients. The pseudo-terminal is the robot's serial line;
+//! each TCP client is a network client of the Basic with a host link of its own, so every
+//! client gets its own answers (the Basic's router serves them in turn and refuses clients
+//! beyond its limit: their connection is closed at once). While clients are talking the tick
 //! is [`ACTIVE_TICK`], so a reply leaves at most that long after the simulated 115200 baud
 //! wire finished sending it (the wire itself takes 87 us per byte, 1.5 ms for a `get_angles`
 //! reply); when the line has been quiet for [`ACTIVE_SPELL`] the loop ticks at [`IDLE_TICK`]
@@ -21,9 +24,11 @@ use protocol_core::timing::HOST_BAUD;
 
 use crate::sim::{HostLink, VirtualRobot};
 
+use super::tcp::ClientId;
+
 use super::pacer::{LinePacer, WINDOW_BYTES};
 use super::pty::PseudoTerminal;
-use super::tcp::{ClientId, TcpServer};
+use super::tcp::TcpServer;
 
 /// The longest the loop sleeps between two advances of virtual time while clients talk.
 pub const ACTIVE_TICK: Duration = Duration::from_micros(50);
@@ -39,7 +44,8 @@ pub const ACTIVE_SPELL: Duration = Duration::from_millis(50);
 /// stopped process), the debt is forgiven instead of fast-forwarding the arm in one jump.
 pub const MAX_CATCH_UP: Duration = Duration::from_millis(50);
 
-/// The robot as the front end sees it: the host end of one serial line, and time.
+/// The robot as the front end sees it: the host end of one serial line, network clients with
+/// a link each, and time.
 pub trait RealtimeRobot {
     /// Virtual time, microseconds since the robot started.
     fn now_us(&self) -> u64;
@@ -49,6 +55,21 @@ pub trait RealtimeRobot {
     fn host_read(&mut self, out: &mut Vec<u8>);
     /// Advances virtual time to `t_us`.
     fn run_until(&mut self, t_us: u64);
+    /// A network client connects (a TCP client, like one of the Basic's Wi-Fi server): the
+    /// link it gets, or `None` to turn it away. The default serves no network clients.
+    fn connect(&mut self) -> Option<HostLink> {
+        None
+    }
+    /// The network client on `link` has gone.
+    fn disconnect(&mut self, _link: HostLink) {}
+    /// How many bytes the network client on `link` may send now.
+    fn link_room(&self, _link: HostLink) -> usize {
+        0
+    }
+    /// Bytes from the network client on `link` into the robot.
+    fn link_write(&mut self, _link: HostLink, _bytes: &[u8]) {}
+    /// Appends what the robot sent to the network client on `link` so far.
+    fn link_read(&mut self, _link: HostLink, _out: &mut Vec<u8>) {}
 }
 
 /// The virtual robot served on one of its USB ports.
@@ -72,13 +93,21 @@ impl RealtimeRobot for ServedRobot {
     fn run_until(&mut self, t_us: u64) {
         self.robot.run_until(t_us);
     }
-}
-
-/// Where the robot's replies go: to whoever sent the last request.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Talker {
-    Pty,
-    Tcp(ClientId),
+    fn connect(&mut self) -> Option<HostLink> {
+        self.robot.connect()
+    }
+    fn disconnect(&mut self, link: HostLink) {
+        self.robot.disconnect(link);
+    }
+    fn link_room(&self, link: HostLink) -> usize {
+        self.robot.link_room(link)
+    }
+    fn link_write(&mut self, link: HostLink, bytes: &[u8]) {
+        self.robot.link_write(link, bytes);
+    }
+    fn link_read(&mut self, link: HostLink, out: &mut Vec<u8>) {
+        self.robot.link_read(link, out);
+    }
 }
 
 /// Something that looks at the robot now and then from inside the loop (the web view takes its
@@ -105,7 +134,8 @@ pub struct RealtimeDriver<R> {
     robot: R,
     pty: PseudoTerminal,
     tcp: Option<TcpServer>,
-    talker: Talker,
+    /// The robot's link for each TCP client.
+    tcp_links: Vec<(ClientId, HostLink)>,
     pacer: LinePacer,
     observer: Option<Observer<R>>,
 }
@@ -117,7 +147,7 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             robot,
             pty,
             tcp,
-            talker: Talker::Pty,
+            tcp_links: Vec::new(),
             pacer: LinePacer::new(HOST_BAUD, WINDOW_BYTES),
             observer: None,
         }
@@ -169,26 +199,28 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             }
 
             let had_input = self.forward_client_input(&mut input)?;
-
-            output.clear();
-            self.robot.host_read(&mut output);
-            if !output.is_empty() {
-                self.deliver(&output)?;
-            }
-            if had_input || !output.is_empty() {
+            let had_output = self.deliver(&mut output)?;
+            if had_input || had_output {
                 last_traffic = Some(Instant::now());
             }
         }
         Ok(self.robot)
     }
 
-    /// Sleeps until a client sends something (if `watch_clients`) or `tick` passes. While the
-    /// line is full the clients are not watched: their pending bytes would wake us at once.
-    fn wait_for_input(&self, tick: Duration, watch_clients: bool) -> io::Result<()> {
+    /// Sleeps until a client sends something or `tick` passes. A client whose link cannot take
+    /// bytes now is not watched (its pending bytes would wake us at once): the pty client while
+    /// its line is full (`watch_pty`), a TCP client while its link has no room.
+    fn wait_for_input(&self, tick: Duration, watch_pty: bool) -> io::Result<()> {
         let pty_fd: BorrowedFd<'_> = std::os::fd::AsFd::as_fd(&self.pty);
+        let has_room = |id: ClientId| {
+            self.tcp_links
+                .iter()
+                .find(|(client, _)| *client == id)
+                .is_some_and(|(_, link)| self.robot.link_room(*link) > 0)
+        };
         let mut fds: Vec<PollFd<'_>> = std::iter::once(pty_fd)
-            .chain(self.tcp.iter().flat_map(TcpServer::poll_fds))
-            .filter(|_| watch_clients)
+            .filter(|_| watch_pty)
+            .chain(self.tcp.iter().flat_map(|tcp| tcp.poll_fds(has_room)))
             .map(|fd| PollFd::new(fd, PollFlags::POLLIN))
             .collect();
         match ppoll(&mut fds, Some(TimeSpec::from_duration(tick)), None) {
@@ -214,36 +246,61 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             self.robot.host_write(bytes);
             self.pacer.consumed(n, now_ns);
             budget -= n;
-            self.talker = Talker::Pty;
             any = true;
         }
         if let Some(tcp) = self.tcp.as_mut() {
-            tcp.accept_pending();
-            let robot = &mut self.robot;
-            let talker = &mut self.talker;
-            let pacer = &mut self.pacer;
-            tcp.receive(budget, |id, bytes| {
-                robot.host_write(bytes);
-                pacer.consumed(bytes.len(), now_ns);
-                *talker = Talker::Tcp(id);
-                any = true;
-            });
+            let (robot, links) = (&mut self.robot, &mut self.tcp_links);
+            tcp.accept_pending(|id| robot.connect().map(|link| links.push((id, link))).is_some());
+            let rooms: Vec<(ClientId, HostLink, usize)> = links
+                .iter()
+                .map(|&(id, link)| (id, link, robot.link_room(link)))
+                .collect();
+            let find = |id: ClientId| rooms.iter().find(|(client, _, _)| *client == id);
+            let mut gone = Vec::new();
+            tcp.receive(
+                |id| find(id).map_or(0, |&(_, _, room)| room),
+                |id, bytes| {
+                    if let Some(&(_, link, _)) = find(id) {
+                        robot.link_write(link, bytes);
+                        any = true;
+                    }
+                },
+                |id| gone.push(id),
+            );
+            for id in gone {
+                if let Some(&(_, link, _)) = find(id) {
+                    robot.disconnect(link);
+                }
+                links.retain(|(client, _)| *client != id);
+            }
         }
         Ok(any)
     }
 
-    fn deliver(&mut self, bytes: &[u8]) -> io::Result<()> {
-        match self.talker {
-            Talker::Pty => {
-                self.pty.write_or_drop(bytes)?;
-            }
-            Talker::Tcp(id) => {
-                if let Some(tcp) = self.tcp.as_mut() {
-                    tcp.send_reply_bytes(id, bytes);
-                }
-            }
+    /// Passes what the robot sent to its clients: the serial line's bytes to the pty, each
+    /// network link's to its TCP client (each reply whole, in one write). Tells whether there
+    /// was anything.
+    fn deliver(&mut self, buf: &mut Vec<u8>) -> io::Result<bool> {
+        buf.clear();
+        self.robot.host_read(buf);
+        let mut any = !buf.is_empty();
+        if any {
+            self.pty.write_or_drop(buf)?;
         }
-        Ok(())
+        if let Some(tcp) = self.tcp.as_mut() {
+            let robot = &mut self.robot;
+            self.tcp_links.retain(|&(id, link)| {
+                buf.clear();
+                robot.link_read(link, buf);
+                any |= !buf.is_empty();
+                let connected = buf.is_empty() || tcp.send(id, buf);
+                if !connected {
+                    robot.disconnect(link);
+                }
+                connected
+            });
+        }
+        Ok(any)
     }
 }
 
@@ -336,6 +393,83 @@ mod tests {
             virtual_end_us > 1_000,
             "virtual time followed the wall clock"
         );
+    }
+
+    /// Reads one frame from `stream` (two seconds at most); nothing if the server closed the
+    /// connection (a reset, if the client had written before being turned away).
+    fn read_frame(stream: &mut std::net::TcpStream) -> Vec<u8> {
+        stream
+            .set_read_timeout(Some(Duration::from_secs(2)))
+            .unwrap();
+        let mut buf = [0u8; 64];
+        match stream.read(&mut buf) {
+            Ok(n) => buf[..n].to_vec(),
+            Err(e) if e.kind() == std::io::ErrorKind::ConnectionReset => Vec::new(),
+            Err(e) => panic!("reading a reply: {e}"),
+        }
+    }
+
+    #[test]
+    fn every_client_gets_its_own_replies_and_one_too_many_is_turned_away() {
+        let served = ServedRobot {
+            robot: VirtualRobot::new(crate::sim::RobotConfig::default()),
+            link: HostLink::Basic,
+        };
+        let tcp = TcpServer::bind("127.0.0.1:0".parse().unwrap()).unwrap();
+        let addr = tcp.local_addr().unwrap();
+        let driver = RealtimeDriver::new(served, PseudoTerminal::open().unwrap(), Some(tcp));
+        let mut pty_client = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(driver.pty().slave_path())
+            .unwrap();
+        let stop = Arc::new(AtomicBool::new(false));
+        let loop_stop = Arc::clone(&stop);
+        let handle = std::thread::spawn(move || driver.run(&loop_stop).map(|_| ()));
+
+        // The USB link and seven network clients: the Basic's limit. The next is turned away.
+        let mut clients: Vec<std::net::TcpStream> = (1..firmware_basic::MAX_HOST_LINKS)
+            .map(|_| std::net::TcpStream::connect(addr).unwrap())
+            .collect();
+        let mut refused = std::net::TcpStream::connect(addr).unwrap();
+        assert!(read_frame(&mut refused).is_empty(), "closed at once");
+
+        // Everyone asks something different at the same time; each gets its own answer.
+        let requests: [u8; 7] = [0xC1, 0xC3, 0xC0, 0x12, 0x20, 0x2B, 0x29];
+        for (client, cmd) in clients.iter_mut().zip(requests) {
+            client.write_all(&[0xFE, 0xFE, 0x02, cmd, 0xFA]).unwrap();
+        }
+        pty_client
+            .write_all(&[0xFE, 0xFE, 0x02, 0x1A, 0xFA])
+            .unwrap();
+        for (client, cmd) in clients.iter_mut().zip(requests) {
+            let reply = read_frame(client);
+            assert_eq!(reply.get(3), Some(&cmd), "{reply:02x?}");
+        }
+        let mut reply = [0u8; 5];
+        pty_client.read_exact(&mut reply[..4]).unwrap();
+        assert_eq!(reply[3], 0x1A);
+
+        // One leaves: a newcomer takes its place.
+        drop(clients.pop());
+        let deadline = Instant::now() + Duration::from_secs(2);
+        let mut newcomer = loop {
+            let mut stream = std::net::TcpStream::connect(addr).unwrap();
+            stream.write_all(&[0xFE, 0xFE, 0x02, 0xC1, 0xFA]).unwrap();
+            let reply = read_frame(&mut stream);
+            if !reply.is_empty() || Instant::now() > deadline {
+                assert_eq!(reply.get(3), Some(&0xC1));
+                break stream;
+            }
+        };
+        newcomer.write_all(&[0xFE, 0xFE, 0x02, 0xC3, 0xFA]).unwrap();
+        assert_eq!(
+            read_frame(&mut newcomer),
+            [0xFE, 0xFE, 0x03, 0xC3, 0x00, 0xFA]
+        );
+
+        stop.store(true, Ordering::Relaxed);
+        handle.join().unwrap().unwrap();
     }
 
     /// Stalls 150 ms (a machine under load) on its second advance; records every advance.

@@ -1,21 +1,18 @@
 //! The host protocol over TCP, like the Basic's Wi-Fi server: raw `FE FE .. FA` frames both
 //! ways, no extra framing. pymycobot's `MyCobot280Socket` talks to it unchanged.
 //!
-//! `MyCobot280Socket` reads each answer with a single `recv(1024)` and takes whatever arrives
-//! first as the whole reply, so replies are sent as complete frames in one write: the bytes
-//! the Basic emits at 115200 baud are collected until a frame is complete, then sent. Several
-//! clients may be connected at once (they take turns on the one robot); a client that
-//! disconnects or misbehaves is dropped without disturbing the robot or the others.
+//! Each connection is one client with a link of its own on the robot (see
+//! [`super::realtime`]): the server only moves bytes. It asks whether to admit each new
+//! connection; one turned away is closed at once, so the client reads end-of-file
+//! (`MyCobot280Socket` raises `BrokenPipeError` on its first command). A client that
+//! disconnects or fails is dropped without disturbing the robot or the others.
 
 use std::io::{self, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::os::fd::{AsFd, BorrowedFd};
 
-use protocol_core::FrameDecoder;
-
-/// How many clients may be connected at once; more are turned away, so a misbehaving script
-/// that opens connections in a loop cannot exhaust file descriptors.
-pub const MAX_TCP_CLIENTS: usize = 8;
+/// Most bytes taken from one client per read.
+const READ_CHUNK: usize = 1024;
 
 /// Identifies one TCP connection for the lifetime of the server (ids are never reused).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -24,8 +21,6 @@ pub struct ClientId(u64);
 struct TcpClient {
     id: ClientId,
     stream: TcpStream,
-    /// Reassembles the robot's byte-timed reply into whole frames for this client.
-    reply_framer: FrameDecoder,
 }
 
 /// A non-blocking TCP server for the host protocol.
@@ -52,9 +47,19 @@ impl TcpServer {
         self.listener.local_addr()
     }
 
-    /// Descriptors to wait on: the listener, then every connected client.
-    pub fn poll_fds(&self) -> impl Iterator<Item = BorrowedFd<'_>> {
-        std::iter::once(self.listener.as_fd()).chain(self.clients.iter().map(|c| c.stream.as_fd()))
+    /// Descriptors to wait on: the listener, then every connected client for which `watch`
+    /// holds (a client whose bytes cannot be taken now is not watched: they would wake the
+    /// loop at once).
+    pub fn poll_fds(
+        &self,
+        watch: impl Fn(ClientId) -> bool,
+    ) -> impl Iterator<Item = BorrowedFd<'_>> {
+        std::iter::once(self.listener.as_fd()).chain(
+            self.clients
+                .iter()
+                .filter(move |c| watch(c.id))
+                .map(|c| c.stream.as_fd()),
+        )
     }
 
     /// How many clients are connected.
@@ -62,25 +67,19 @@ impl TcpServer {
         self.clients.len()
     }
 
-    /// Accepts every pending connection (turning away those above [`MAX_TCP_CLIENTS`]).
-    pub fn accept_pending(&mut self) {
+    /// Accepts every pending connection that `admit` lets in; the others are closed at once.
+    pub fn accept_pending(&mut self, mut admit: impl FnMut(ClientId) -> bool) {
         loop {
             match self.listener.accept() {
                 Ok((stream, _peer)) => {
-                    if self.clients.len() >= MAX_TCP_CLIENTS {
+                    let id = ClientId(self.next_id);
+                    self.next_id += 1;
+                    if stream.set_nonblocking(true).is_err() || !admit(id) {
                         continue; // dropping the stream closes it
-                    }
-                    if stream.set_nonblocking(true).is_err() {
-                        continue;
                     }
                     // Replies are tiny and latency is the point.
                     let _ = stream.set_nodelay(true);
-                    self.clients.push(TcpClient {
-                        id: ClientId(self.next_id),
-                        stream,
-                        reply_framer: FrameDecoder::new(),
-                    });
-                    self.next_id += 1;
+                    self.clients.push(TcpClient { id, stream });
                 }
                 Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
                 // WouldBlock: none left. Anything else (e.g. EMFILE) is retried next round.
@@ -89,55 +88,61 @@ impl TcpServer {
         }
     }
 
-    /// Reads up to `budget` bytes of what clients sent, handing them to `on_bytes`; the rest
-    /// waits in the kernel (TCP flow control slows the client). Drops clients that closed
-    /// their connection or failed.
-    pub fn receive(&mut self, mut budget: usize, mut on_bytes: impl FnMut(ClientId, &[u8])) {
-        let mut buf = [0u8; 1024];
+    /// Reads what clients sent, at most `room(id)` bytes from each (the rest waits in the
+    /// kernel: TCP flow control slows the client), handing them to `on_bytes`. Clients that
+    /// closed their connection or failed are dropped and given to `on_gone`.
+    pub fn receive(
+        &mut self,
+        room: impl Fn(ClientId) -> usize,
+        mut on_bytes: impl FnMut(ClientId, &[u8]),
+        mut on_gone: impl FnMut(ClientId),
+    ) {
+        let mut buf = [0u8; READ_CHUNK];
         self.clients.retain_mut(|client| {
-            while let Some(window) = buf.get_mut(..budget.min(1024)).filter(|w| !w.is_empty()) {
+            let mut budget = room(client.id);
+            while let Some(window) = buf
+                .get_mut(..budget.min(READ_CHUNK))
+                .filter(|w| !w.is_empty())
+            {
                 match client.stream.read(window) {
-                    Ok(0) => return false,
+                    Ok(0) => {
+                        on_gone(client.id);
+                        return false;
+                    }
                     Ok(n) => {
                         budget -= n;
                         on_bytes(client.id, window.get(..n).unwrap_or_default());
                     }
                     Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
                     Err(e) if e.kind() == io::ErrorKind::WouldBlock => return true,
-                    Err(_) => return false,
+                    Err(_) => {
+                        on_gone(client.id);
+                        return false;
+                    }
                 }
             }
             true
         });
     }
 
-    /// Passes the robot's reply bytes to client `to`, sending each frame once it is complete.
-    /// Bytes outside frames are dropped; so is everything for a client that is gone.
-    pub fn send_reply_bytes(&mut self, to: ClientId, bytes: &[u8]) {
+    /// Sends `bytes` to client `to` in one write (the robot hands over each reply whole, and
+    /// `MyCobot280Socket` takes what one `recv` returns as the reply). Dropped for a client
+    /// that is gone; a client that does not read its replies loses them rather than stalling
+    /// the robot. Returns false if the connection broke (the client is then closed; the next
+    /// [`Self::receive`] does not report it again).
+    pub fn send(&mut self, to: ClientId, bytes: &[u8]) -> bool {
         let Some(index) = self.clients.iter().position(|c| c.id == to) else {
-            return;
+            return true;
         };
         let Some(client) = self.clients.get_mut(index) else {
-            return;
+            return true;
         };
-        let mut healthy = true;
-        let TcpClient {
-            stream,
-            reply_framer,
-            ..
-        } = client;
-        reply_framer.feed(bytes, |frame| {
-            // A client that does not read its replies loses them (WouldBlock) rather than
-            // stalling the robot; a broken connection is closed.
-            if healthy
-                && let Err(e) = stream.write_all(&frame.to_bytes())
-                && e.kind() != io::ErrorKind::WouldBlock
-            {
-                healthy = false;
+        match client.stream.write_all(bytes) {
+            Err(e) if e.kind() != io::ErrorKind::WouldBlock => {
+                self.clients.swap_remove(index);
+                false
             }
-        });
-        if !healthy {
-            self.clients.swap_remove(index);
+            _ => true,
         }
     }
 }
@@ -151,38 +156,68 @@ mod tests {
         TcpServer::bind("127.0.0.1:0".parse().unwrap()).unwrap()
     }
 
-    /// Accepts and reads until `want` bytes arrived from some client (or two seconds passed).
-    fn pump(server: &mut TcpServer, want: usize) -> Vec<(ClientId, Vec<u8>)> {
+    /// Accepts everyone and reads until `want` bytes arrived from some client (or two seconds
+    /// passed), at most `room` bytes per client per round.
+    fn pump(server: &mut TcpServer, want: usize, room: usize) -> Vec<(ClientId, Vec<u8>)> {
         let deadline = Instant::now() + Duration::from_secs(2);
         let mut got: Vec<(ClientId, Vec<u8>)> = Vec::new();
         while got.iter().map(|(_, b)| b.len()).sum::<usize>() < want && Instant::now() < deadline {
-            server.accept_pending();
-            server.receive(usize::MAX, |id, bytes| got.push((id, bytes.to_vec())));
+            server.accept_pending(|_| true);
+            server.receive(|_| room, |id, bytes| got.push((id, bytes.to_vec())), |_| {});
             std::thread::sleep(Duration::from_millis(1));
         }
         got
     }
 
     #[test]
-    fn a_reply_trickling_in_byte_by_byte_reaches_the_client_as_one_frame() {
+    fn a_reply_reaches_the_client_in_one_read() {
         let mut server = localhost_server();
         let mut client = TcpStream::connect(server.local_addr().unwrap()).unwrap();
         client.write_all(&[0xFE, 0xFE, 0x02, 0x20, 0xFA]).unwrap();
-        let got = pump(&mut server, 5);
+        let got = pump(&mut server, 5, usize::MAX);
         let (id, bytes) = got.first().unwrap();
         assert_eq!(bytes, &[0xFE, 0xFE, 0x02, 0x20, 0xFA]);
 
         let reply = [0xFE, 0xFE, 0x04, 0x20, 0xFE, 0xFA, 0xFA];
-        server.send_reply_bytes(*id, &[0x00, 0x55]); // line noise before the frame
-        for byte in reply {
-            server.send_reply_bytes(*id, &[byte]);
-        }
+        assert!(server.send(*id, &reply));
         client
             .set_read_timeout(Some(Duration::from_secs(2)))
             .unwrap();
         let mut buf = [0u8; 64];
         let n = client.read(&mut buf).unwrap();
         assert_eq!(&buf[..n], &reply);
+    }
+
+    #[test]
+    fn a_client_takes_no_more_than_its_room() {
+        let mut server = localhost_server();
+        let mut client = TcpStream::connect(server.local_addr().unwrap()).unwrap();
+        client.write_all(&[7; 100]).unwrap();
+        let got = pump(&mut server, 10, 10);
+        assert!(got.iter().all(|(_, b)| b.len() <= 10), "{got:?}");
+        let rest = pump(&mut server, 90, 30);
+        let total: usize = got.iter().chain(&rest).map(|(_, b)| b.len()).sum();
+        assert_eq!(total, 100, "nothing lost: the rest waited in the kernel");
+    }
+
+    #[test]
+    fn a_client_turned_away_reads_end_of_file() {
+        let mut server = localhost_server();
+        let mut refused = TcpStream::connect(server.local_addr().unwrap()).unwrap();
+        let deadline = Instant::now() + Duration::from_secs(2);
+        let mut asked = 0;
+        while asked == 0 && Instant::now() < deadline {
+            server.accept_pending(|_| {
+                asked += 1;
+                false
+            });
+        }
+        assert_eq!((asked, server.client_count()), (1, 0));
+        refused
+            .set_read_timeout(Some(Duration::from_secs(2)))
+            .unwrap();
+        let mut buf = [0u8; 8];
+        assert_eq!(refused.read(&mut buf).unwrap(), 0, "closed at once");
     }
 
     #[test]
@@ -193,18 +228,21 @@ mod tests {
         let mut second = TcpStream::connect(addr).unwrap();
         first.write_all(&[1]).unwrap();
         second.write_all(&[2]).unwrap();
-        let got = pump(&mut server, 2);
+        let got = pump(&mut server, 2, usize::MAX);
         assert_eq!(server.client_count(), 2);
+        let first_id = got.iter().find(|(_, b)| b == &[1]).unwrap().0;
         let second_id = got.iter().find(|(_, b)| b == &[2]).unwrap().0;
 
         drop(first);
         let deadline = Instant::now() + Duration::from_secs(2);
+        let mut gone = Vec::new();
         while server.client_count() == 2 && Instant::now() < deadline {
-            server.receive(usize::MAX, |_, _| {});
+            server.receive(|_| usize::MAX, |_, _| {}, |id| gone.push(id));
         }
         assert_eq!(server.client_count(), 1);
+        assert_eq!(gone, [first_id]);
 
-        server.send_reply_bytes(second_id, &[0xFE, 0xFE, 0x03, 0x10, 0x01, 0xFA]);
+        assert!(server.send(second_id, &[0xFE, 0xFE, 0x03, 0x10, 0x01, 0xFA]));
         second
             .set_read_timeout(Some(Duration::from_secs(2)))
             .unwrap();

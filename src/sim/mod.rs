@@ -10,9 +10,10 @@
 //! What a test or a tool can do with it:
 //!
 //! * talk like a host: [`VirtualRobot::host_write`] / [`VirtualRobot::host_read`] (the Basic's
-//!   USB), [`VirtualRobot::link_write`] / [`VirtualRobot::link_read`] (either board's USB),
-//!   or one request at a time with [`VirtualRobot::ask`], [`VirtualRobot::transact`] and
-//!   [`VirtualRobot::await_frame`];
+//!   USB), [`VirtualRobot::link_write`] / [`VirtualRobot::link_read`] (either board's USB, or
+//!   a network client of the Basic from [`VirtualRobot::connect`]: several at once, each with
+//!   its own answers), or one request at a time with [`VirtualRobot::ask`],
+//!   [`VirtualRobot::transact`] and [`VirtualRobot::await_frame`];
 //! * drive it in real time: call [`VirtualRobot::run_until`] with the wall clock;
 //! * break things: [`SimServo::set_faults`] (no answer, bad checksum, stall, overheat),
 //!   [`SimServo::power_cycle`], [`SimServo::move_by_hand`], [`VirtualRobot::inject_bus_noise`],
@@ -38,7 +39,8 @@ mod robot;
 pub use sim_hw::{servo, wire};
 
 pub use robot::{
-    AskError, HostLink, POLL_PERIOD_NS, RobotConfig, SERVO_IDS, SimBasicIo, VirtualRobot,
+    AskError, HostLink, NET_BUFFER_BYTES, NetClient, POLL_PERIOD_NS, RobotConfig, SERVO_IDS,
+    SimBasicIo, VirtualRobot,
 };
 pub use servo::{Faults, PacketListener, ServoStats, SimServo};
 pub use wire::{Bus, BusByte, HeardByte, SerialLine, StationId};

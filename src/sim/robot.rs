@@ -1,12 +1,14 @@
 //! The whole virtual arm under virtual time: the real Basic and Atom firmware libraries, the
 //! shared bus, seven simulated servos, and the USB serial links of both boards.
 
+use std::collections::VecDeque;
+
 use firmware_atom::{Atom, AtomConfig, RecordingIo};
-use firmware_basic::{Basic, BasicConfig, BasicIo, Buttons};
+use firmware_basic::{Basic, BasicConfig, BasicIo, Buttons, HostPorts, LinkId, LinkKind};
 use protocol_core::command::{Reply, ReplyError, Request};
 use protocol_core::timing::{HOST_BAUD, HOST_REPLY_DEADLINE_US};
 use protocol_core::units::{Centideg, Steps};
-use protocol_core::{Frame, FrameDecoder};
+use protocol_core::{BytePort, Frame, FrameDecoder};
 
 use super::servo::SimServo;
 use super::wire::{Bus, HeardByte, SerialLine, SerialPort, StationId};
@@ -171,6 +173,53 @@ impl UsbLink {
     }
 }
 
+/// Bytes a network client may have on their way to the Basic at once; a client that sends more
+/// waits (TCP flow control: [`VirtualRobot::link_room`]).
+pub const NET_BUFFER_BYTES: usize = 4096;
+
+/// A network client of the Basic: one of its host links, with no wire time (what one side
+/// writes, the other can read at once).
+#[derive(Clone, Debug)]
+struct NetLink {
+    client: NetClient,
+    link: LinkId,
+    to_board: VecDeque<u8>,
+    to_host: VecDeque<u8>,
+}
+
+/// The Basic's host links as its firmware sees them: the USB serial and the network clients.
+struct BasicPorts<'a> {
+    usb: SerialPort<'a>,
+    net: &'a mut [NetLink],
+}
+
+impl BasicPorts<'_> {
+    fn net(&mut self, link: LinkId) -> Option<&mut NetLink> {
+        self.net.iter_mut().find(|n| n.link == link)
+    }
+}
+
+impl HostPorts for BasicPorts<'_> {
+    fn read_from(&mut self, link: LinkId) -> Option<u8> {
+        if link == LinkId::USB {
+            return self.usb.read_byte();
+        }
+        self.net(link)?.to_board.pop_front()
+    }
+
+    fn write_to(&mut self, link: LinkId, bytes: &[u8]) {
+        if link == LinkId::USB {
+            self.usb.write(bytes);
+        } else if let Some(net) = self.net(link) {
+            net.to_host.extend(bytes);
+        }
+    }
+
+    fn tx_idle_on(&self, link: LinkId) -> bool {
+        link != LinkId::USB || self.usb.tx_idle()
+    }
+}
+
 struct BasicBoard {
     firmware: Basic,
     config: BasicConfig,
@@ -179,7 +228,15 @@ struct BasicBoard {
     boot_ns: u64,
     station: StationId,
     usb: UsbLink,
+    /// The network clients connected now.
+    net: Vec<NetLink>,
     io: SimBasicIo,
+}
+
+impl BasicBoard {
+    fn net_mut(&mut self, client: NetClient) -> Option<&mut NetLink> {
+        self.net.iter_mut().find(|n| n.client == client)
+    }
 }
 
 /// Why [`VirtualRobot::ask`] got no usable answer.
@@ -196,14 +253,22 @@ pub enum AskError {
     BadReply(ReplyError),
 }
 
-/// Which USB port a host talks to.
+/// Which link a host talks to the arm on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HostLink {
     /// The Basic's USB serial (the normal way; falls silent without a Basic).
     Basic,
     /// The Atom's own USB serial (direct host link).
     AtomUsb,
+    /// A network client of the Basic (TCP, like its Wi-Fi server): one of its host links, from
+    /// [`VirtualRobot::connect`].
+    Network(NetClient),
 }
+
+/// One network client of the Basic, from [`VirtualRobot::connect`]; never reused, so a client
+/// that has gone (or lost its link when the Basic restarted) reaches nobody.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct NetClient(u64);
 
 /// The virtual myCobot 280 M5. See the [simulation overview](crate::sim).
 ///
@@ -225,6 +290,8 @@ pub struct VirtualRobot {
     heard: Vec<HeardByte>,
     noise_station: StationId,
     next_poll_ns: u64,
+    /// The id of the next network client.
+    next_client: u64,
 }
 
 impl VirtualRobot {
@@ -239,6 +306,7 @@ impl VirtualRobot {
             boot_ns: 0,
             station: bus.attach(config.basic_hears_echo),
             usb: UsbLink::new(),
+            net: Vec::new(),
             io: SimBasicIo::default(),
         });
         let atom_station = bus.attach(config.atom_hears_echo);
@@ -263,6 +331,7 @@ impl VirtualRobot {
             heard: Vec::new(),
             noise_station,
             next_poll_ns: 0,
+            next_client: 0,
         }
     }
 
@@ -297,11 +366,28 @@ impl VirtualRobot {
         self.link_read(HostLink::AtomUsb, out);
     }
 
-    /// Sends `bytes` from a host into `link`.
+    /// Sends `bytes` from a host into `link`. On a network link, what does not fit in
+    /// [`VirtualRobot::link_room`] is dropped.
     pub fn link_write(&mut self, link: HostLink, bytes: &[u8]) {
         let now = self.now_ns;
         if let Some(usb) = self.usb_mut(link) {
             usb.to_board.send(now, bytes);
+        } else if let Some(net) = self.net_mut(link) {
+            let room = NET_BUFFER_BYTES.saturating_sub(net.to_board.len());
+            net.to_board.extend(bytes.iter().take(room).copied());
+        }
+    }
+
+    /// How many bytes `link` takes now: a serial line queues everything (its wire time paces
+    /// it), a network link at most [`NET_BUFFER_BYTES`] waiting for the Basic.
+    pub fn link_room(&self, link: HostLink) -> usize {
+        match link {
+            HostLink::Network(client) => self
+                .basic
+                .as_ref()
+                .and_then(|b| b.net.iter().find(|n| n.client == client))
+                .map_or(0, |n| NET_BUFFER_BYTES.saturating_sub(n.to_board.len())),
+            HostLink::Basic | HostLink::AtomUsb => usize::MAX,
         }
     }
 
@@ -309,13 +395,73 @@ impl VirtualRobot {
     pub fn link_read(&mut self, link: HostLink, out: &mut Vec<u8>) {
         if let Some(usb) = self.usb_mut(link) {
             usb.to_host.receive_all(out);
+        } else if let Some(net) = self.net_mut(link) {
+            out.extend(net.to_host.drain(..));
         }
+    }
+
+    /// Takes the next byte that arrived at the host on `link`.
+    fn link_receive(&mut self, link: HostLink) -> Option<u8> {
+        if let Some(usb) = self.usb_mut(link) {
+            return usb.to_host.receive();
+        }
+        self.net_mut(link)?.to_host.pop_front()
     }
 
     fn usb_mut(&mut self, link: HostLink) -> Option<&mut UsbLink> {
         match link {
             HostLink::Basic => self.basic.as_mut().map(|b| &mut b.usb),
             HostLink::AtomUsb => Some(&mut self.atom_usb),
+            HostLink::Network(_) => None,
+        }
+    }
+
+    fn net_mut(&mut self, link: HostLink) -> Option<&mut NetLink> {
+        match link {
+            HostLink::Network(client) => self.basic.as_mut()?.net_mut(client),
+            HostLink::Basic | HostLink::AtomUsb => None,
+        }
+    }
+
+    /// A network client connects to the Basic (like a TCP client to its Wi-Fi server): the
+    /// Basic opens a host link for it, with its own framer, queue and turn on the bus. `None`
+    /// if the Basic refuses it (it serves `firmware_basic::MAX_HOST_LINKS` links, the USB one
+    /// included) or the robot has no Basic.
+    pub fn connect(&mut self) -> Option<HostLink> {
+        let basic = self.basic.as_mut()?;
+        let link = basic.firmware.open_link(LinkKind::Network).ok()?;
+        let client = NetClient(self.next_client);
+        self.next_client += 1;
+        basic.net.push(NetLink {
+            client,
+            link,
+            to_board: VecDeque::new(),
+            to_host: VecDeque::new(),
+        });
+        Some(HostLink::Network(client))
+    }
+
+    /// A network client leaves: the Basic closes its link. No-op for the USB links.
+    pub fn disconnect(&mut self, link: HostLink) {
+        let (HostLink::Network(client), Some(basic)) = (link, self.basic.as_mut()) else {
+            return;
+        };
+        if let Some(index) = basic.net.iter().position(|n| n.client == client) {
+            let gone = basic.net.swap_remove(index);
+            basic.firmware.close_link(gone.link);
+        }
+    }
+
+    /// True while `link` reaches a board: always for the USB ports of the boards there are,
+    /// for a network client until it disconnects or the Basic restarts.
+    pub fn link_connected(&self, link: HostLink) -> bool {
+        match link {
+            HostLink::Basic => self.basic.is_some(),
+            HostLink::AtomUsb => true,
+            HostLink::Network(client) => self
+                .basic
+                .as_ref()
+                .is_some_and(|b| b.net.iter().any(|n| n.client == client)),
         }
     }
 
@@ -329,12 +475,14 @@ impl VirtualRobot {
     }
 
     /// Resets the Basic now, like [`VirtualRobot::reset_atom`]; what the host sent and the
-    /// Basic had not read yet is lost. No-op without a Basic.
+    /// Basic had not read yet is lost, and so are its network clients' connections. No-op
+    /// without a Basic.
     pub fn reset_basic(&mut self) {
         if let Some(basic) = self.basic.as_mut() {
             basic.firmware = Basic::new(basic.config);
             basic.boot_ns = self.now_ns;
             basic.usb = UsbLink::new();
+            basic.net.clear();
             self.bus.reset_station(basic.station);
         }
     }
@@ -403,11 +551,14 @@ impl VirtualRobot {
             && basic.main_loop.runs_at(now_ns)
             && let Some(mut bus) = self.bus.port(basic.station)
         {
-            let mut host = basic.usb.board_port(now_ns);
+            let mut hosts = BasicPorts {
+                usb: basic.usb.board_port(now_ns),
+                net: &mut basic.net,
+            };
             let basic_us = (now_ns - basic.boot_ns) / 1_000;
             basic
                 .firmware
-                .poll(basic_us, &mut host, &mut bus, &mut basic.io);
+                .poll(basic_us, &mut hosts, &mut bus, &mut basic.io);
         }
         if self.atom_loop.runs_at(now_ns)
             && let Some(mut bus) = self.bus.port(self.atom_station)
@@ -440,7 +591,7 @@ impl VirtualRobot {
         let deadline = self.now_us().saturating_add(timeout_us);
         let mut decoder = FrameDecoder::new();
         loop {
-            while let Some(byte) = self.usb_mut(link).and_then(|usb| usb.to_host.receive()) {
+            while let Some(byte) = self.link_receive(link) {
                 if let Some(frame) = decoder.push(byte) {
                     return Some(frame);
                 }

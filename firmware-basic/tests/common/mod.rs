@@ -1,15 +1,19 @@
-//! A simulated Basic board for tests and benchmarks: a host link and the shared bus of `sim-hw`
-//! (byte timing, echo, collisions), a scripted Atom, other stations that inject traffic, and
-//! virtual time.
+//! A simulated Basic board for tests and benchmarks: host links (the USB serial and network
+//! clients), the shared bus of `sim-hw` (byte timing, echo, collisions), a scripted Atom, other
+//! stations that inject traffic, and virtual time.
 //!
 //! Two transmissions that overlap on the bus garble each other for every listener. The Basic
 //! hears everything the others send, and its own bytes when `echo` is on; the scripted Atom
 //! listens to the Basic.
 #![allow(dead_code, clippy::unwrap_used, clippy::indexing_slicing)]
 
+pub mod clients;
+
 use std::collections::VecDeque;
 
-use firmware_basic::{Basic, BasicConfig, BasicIo, Buttons};
+use firmware_basic::{
+    Basic, BasicConfig, BasicIo, Buttons, HostPorts, LinkId, LinkKind, LinksFull, MAX_HOST_LINKS,
+};
 use protocol_core::listener::{Heard, Listener, ListenerConfig};
 use protocol_core::{BytePort, Frame, FrameDecoder, timing};
 use sim_hw::{Bus, HeardByte, StationId};
@@ -182,17 +186,46 @@ impl Wire {
     }
 }
 
-/// The host side: what the host sends (with 115200 timing) and what the Basic wrote.
-#[derive(Default)]
+/// A client's side of a host link: what it sends (with the link's byte timing) and what the
+/// Basic wrote.
 pub struct HostPort {
     now_ns: u64,
+    /// Time of one byte on the link, ns: 115200 baud for the USB serial, 0 for a network
+    /// client (whatever it writes is there at once).
+    byte_ns: u64,
     to_basic: VecDeque<(u64, u8)>,
     tx_busy_until_ns: u64,
     /// Bytes the Basic wrote, with the time (ns) each started on the wire.
     pub from_basic: Vec<(u64, u8)>,
 }
 
+impl Default for HostPort {
+    fn default() -> Self {
+        Self::serial()
+    }
+}
+
 impl HostPort {
+    /// The USB serial at 115200 baud.
+    pub fn serial() -> Self {
+        Self::with_byte_ns(HOST_BYTE_NS)
+    }
+
+    /// A network client: no wire time.
+    pub fn network() -> Self {
+        Self::with_byte_ns(0)
+    }
+
+    fn with_byte_ns(byte_ns: u64) -> Self {
+        Self {
+            now_ns: 0,
+            byte_ns,
+            to_basic: VecDeque::new(),
+            tx_busy_until_ns: 0,
+            from_basic: Vec::new(),
+        }
+    }
+
     /// Queues `bytes` from the host, back to back after whatever is queued, from `now`;
     /// returns when the last of them has arrived, in ns.
     pub fn send(&mut self, bytes: &[u8]) -> u64 {
@@ -201,10 +234,17 @@ impl HostPort {
             .back()
             .map_or(self.now_ns, |&(end, _)| end.max(self.now_ns));
         for &b in bytes {
-            end += HOST_BYTE_NS;
+            end += self.byte_ns;
             self.to_basic.push_back((end, b));
         }
         end
+    }
+
+    /// The frames the Basic sent to this client so far, decoded.
+    pub fn frames(&self) -> Vec<Frame> {
+        let mut out = Vec::new();
+        FrameDecoder::new().feed(&self.received(), |f| out.push(f));
+        out
     }
 
     /// The bytes the Basic sent to the host so far.
@@ -227,9 +267,9 @@ impl BytePort for HostPort {
     fn write(&mut self, bytes: &[u8]) {
         let start = self.now_ns.max(self.tx_busy_until_ns);
         for (i, &b) in bytes.iter().enumerate() {
-            self.from_basic.push((start + i as u64 * HOST_BYTE_NS, b));
+            self.from_basic.push((start + i as u64 * self.byte_ns, b));
         }
-        self.tx_busy_until_ns = start + bytes.len() as u64 * HOST_BYTE_NS;
+        self.tx_busy_until_ns = start + bytes.len() as u64 * self.byte_ns;
     }
 
     fn tx_idle(&self) -> bool {
@@ -287,12 +327,52 @@ pub fn ack_everything() -> Responder {
     })
 }
 
+/// Every host link's client side, for [`Basic::poll`]: the USB serial and the network clients
+/// by link index.
+struct RigPorts<'a> {
+    usb: &'a mut HostPort,
+    clients: &'a mut [Option<HostPort>],
+}
+
+impl RigPorts<'_> {
+    fn port(&mut self, link: LinkId) -> Option<&mut HostPort> {
+        if link == LinkId::USB {
+            return Some(self.usb);
+        }
+        self.clients.get_mut(link.index())?.as_mut()
+    }
+}
+
+impl HostPorts for RigPorts<'_> {
+    fn read_from(&mut self, link: LinkId) -> Option<u8> {
+        self.port(link)?.read_byte()
+    }
+
+    fn write_to(&mut self, link: LinkId, bytes: &[u8]) {
+        if let Some(port) = self.port(link) {
+            port.write(bytes);
+        }
+    }
+
+    fn tx_idle_on(&self, link: LinkId) -> bool {
+        if link == LinkId::USB {
+            return self.usb.tx_idle();
+        }
+        self.clients
+            .get(link.index())
+            .and_then(Option::as_ref)
+            .is_none_or(HostPort::tx_idle)
+    }
+}
+
 /// The Basic, its ports and a scripted Atom on one simulated wire.
 pub struct Rig {
     /// The firmware under test.
     pub basic: Basic,
-    /// The host link.
+    /// The USB host link.
     pub host: HostPort,
+    /// The network clients, by link index (`None`: no client there).
+    pub clients: Vec<Option<HostPort>>,
     /// The shared bus.
     wire: Wire,
     /// The Basic's pins.
@@ -319,6 +399,7 @@ impl Rig {
         Self {
             basic: Basic::new(config),
             host: HostPort::default(),
+            clients: (0..MAX_HOST_LINKS).map(|_| None).collect(),
             wire: Wire::new(echo),
             io: MemIo::default(),
             now_ns: 0,
@@ -348,6 +429,31 @@ impl Rig {
         &mut self.wire
     }
 
+    /// A network client connects: the Basic opens a link for it.
+    pub fn connect(&mut self) -> Result<LinkId, LinksFull> {
+        let link = self.basic.open_link(LinkKind::Network)?;
+        if let Some(slot) = self.clients.get_mut(link.index()) {
+            *slot = Some(HostPort::network());
+        }
+        Ok(link)
+    }
+
+    /// The network client on `link` leaves.
+    pub fn disconnect(&mut self, link: LinkId) {
+        self.basic.close_link(link);
+        if let Some(slot) = self.clients.get_mut(link.index()) {
+            *slot = None;
+        }
+    }
+
+    /// The client side of `link` (the USB serial, or a network client).
+    pub fn client(&mut self, link: LinkId) -> &mut HostPort {
+        if link == LinkId::USB {
+            return &mut self.host;
+        }
+        self.clients[link.index()].as_mut().unwrap()
+    }
+
     /// One poll at the current time (after the wire has run up to it), then time moves on by
     /// one step.
     pub fn step(&mut self) {
@@ -357,9 +463,16 @@ impl Rig {
         self.wire.arrive(self.now_ns);
         self.run_atom();
         self.host.now_ns = self.now_ns;
+        for client in self.clients.iter_mut().flatten() {
+            client.now_ns = self.now_ns;
+        }
         let mut bus = self.wire.bus.port(self.wire.basic).unwrap();
+        let mut ports = RigPorts {
+            usb: &mut self.host,
+            clients: &mut self.clients,
+        };
         self.basic
-            .poll(self.now_ns / 1_000, &mut self.host, &mut bus, &mut self.io);
+            .poll(self.now_ns / 1_000, &mut ports, &mut bus, &mut self.io);
         self.atom_send();
         self.wire.start_transmissions();
         self.now_ns += self.step_ns;
@@ -428,6 +541,26 @@ impl Rig {
         let mut out = Vec::new();
         d.feed(&self.host.received(), |f| out.push(f));
         out
+    }
+}
+
+/// PING servo 1, a raw servo packet for transparent mode...
+pub const PING: [u8; 6] = [0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB];
+/// ...and the servo's status reply.
+pub const PING_REPLY: [u8; 6] = [0xFF, 0xFF, 0x01, 0x02, 0x00, 0xFC];
+
+impl Rig {
+    /// The client on `link` sends [`PING`] in transparent mode and the servo answers
+    /// [`PING_REPLY`] 50 us after it: returns every byte the Basic has put on the bus so far,
+    /// and what the client has received.
+    pub fn ping_servo_raw(&mut self, link: LinkId) -> (Vec<u8>, Vec<u8>) {
+        self.client(link).send(&PING);
+        self.run_us(2_000);
+        let sent = self.wire.basic_sent.iter().map(|&(_, b)| b).collect();
+        let now = self.now_ns;
+        self.wire.inject(now + 50_000, &PING_REPLY);
+        self.run_us(1_000);
+        (sent, self.client(link).received())
     }
 }
 

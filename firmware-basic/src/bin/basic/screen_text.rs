@@ -66,6 +66,9 @@ fn write_row(out: &mut Line, row: usize, s: &BasicStatus) -> fmt::Result {
             Some(BasicError::ReplyTimeout { cmd }) => write!(out, "no reply to 0x{cmd:02X}"),
             Some(BasicError::BusCollisions { cmd }) => write!(out, "bus collisions 0x{cmd:02X}"),
             Some(BasicError::QueueFull { cmd }) => write!(out, "queue full, dropped 0x{cmd:02X}"),
+            Some(BasicError::TransparentElsewhere { cmd }) => {
+                write!(out, "transparent, dropped 0x{cmd:02X}")
+            }
             Some(BasicError::InvalidPin { pin }) => write!(out, "no such pin {pin}"),
             Some(BasicError::HostOverflow) => write!(out, "host link overflow"),
         },
