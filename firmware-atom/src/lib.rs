@@ -70,4 +70,4 @@ pub use atom::Atom;
 pub use config::{AtomConfig, ConfigError, JointLimit, JointSign, TimingBudget};
 pub use error::AtomError;
 pub use health::ServoHealth;
-pub use io::{AtomIo, PinMode, RecordingIo};
+pub use io::{AtomIo, PinMode, RecordingIo, Wiring};

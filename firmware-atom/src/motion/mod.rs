@@ -32,6 +32,7 @@ use crate::error::AtomError;
 use crate::settings::Settings;
 use brake::Braking;
 use follow::{Follower, Pace};
+pub use brake::stop_one;
 use path::{PathRunner, Step};
 pub use plan::{IN_POSITION_CENTIDEG, MOVE_OVERTIME_US, angles_match};
 pub use stream::STREAM_GAP_MAX_US;
