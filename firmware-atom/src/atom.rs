@@ -5,6 +5,8 @@
 //!   through the safety check).
 //! * [`MotionController`]: moves, paths, streams, jogs, braking, the queue.
 //! * [`Gripper`]: the gripper's range and settings.
+//! * [`DragRecorder`]: drag teaching, fed from the bank's state reads.
+//! * [`Gains`]: the servos' position-loop gains (0x2C / 0x2D).
 //! * [`ErrorLog`]: the error state 0x07 reports.
 //! * [`BusSchedule`]: who talks on the shared wire when; [`UsbLink`]: the Atom's own USB.
 //!
@@ -15,7 +17,9 @@ use protocol_core::{BytePort, Frame};
 
 use crate::bank::ServoBank;
 use crate::config::{AtomConfig, ConfigError, GRIPPER, JOINTS, JointLimit};
+use crate::drag::DragRecorder;
 use crate::error::ErrorLog;
+use crate::gains::Gains;
 use crate::gripper::Gripper;
 use crate::health::ServoHealth;
 use crate::io::AtomIo;
@@ -35,6 +39,10 @@ pub(crate) struct Parts {
     pub motion: MotionController,
     /// The gripper.
     pub gripper: Gripper,
+    /// Drag teaching.
+    pub drag: DragRecorder,
+    /// The servos' gains.
+    pub gains: Gains,
     /// The error state (0x07).
     pub errors: ErrorLog,
 }
@@ -62,6 +70,8 @@ impl Atom {
                 bank: ServoBank::new(&settings),
                 motion: MotionController::new(),
                 gripper: Gripper::new(&settings),
+                drag: DragRecorder::new(),
+                gains: Gains::default(),
                 errors: ErrorLog::default(),
                 settings,
             },
@@ -106,6 +116,7 @@ impl Atom {
         } = &mut self.parts;
         let moved = motion.update(now_us, bank, settings);
         errors.note(moved).ok();
+        self.parts.drag.poll(now_us, &self.parts.bank);
         self.update_button(now_us, io);
         self.schedule
             .start_next(now_us, bus, &mut self.parts.bank, &self.parts.settings);
@@ -168,11 +179,13 @@ impl Atom {
         usb: &mut U,
     ) {
         let corrupt = self.schedule.saw_corruption();
-        let done = self
-            .parts
-            .bank
-            .finish(&self.parts.settings, op, outcome, corrupt);
-        if let Some(done) = done {
+        let done =
+            self.parts
+                .bank
+                .finish(&self.parts.settings, op.clone(), outcome.clone(), corrupt);
+        let retrying = self.parts.bank.due_job().as_ref() == Some(&op);
+        let gains = self.parts.gains.finished(&op, &outcome, retrying);
+        for done in done.into_iter().chain(gains) {
             match done.link {
                 Link::Bus => self.schedule.send_reply(done.reply),
                 Link::Usb => usb.write(&done.reply.to_bytes()),
@@ -255,5 +268,11 @@ impl Atom {
     /// True while the gripper servo moves.
     pub fn gripper_moving(&self) -> bool {
         self.parts.bank.servo_moving(GRIPPER)
+    }
+
+    /// Drag-teaching points recorded (0xF4), and whether it is still recording (a full buffer
+    /// stops it).
+    pub fn drag_record(&self) -> (u16, bool) {
+        (self.parts.drag.recorded(), self.parts.drag.is_recording())
     }
 }

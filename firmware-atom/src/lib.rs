@@ -46,6 +46,10 @@
 //!   rate; EEPROM registers are unlocked and locked around the write.
 //! * **Free mode** (0x1A 1): holding the Atom's button releases the joints so the arm can be
 //!   moved by hand; letting go holds it where it is.
+//! * **Drag teaching** (0xF1..0xF5): every joint's encoder and speed recorded 20 times a second
+//!   into 1 000 points, read back one point per request ([`drag`]).
+//! * **Circular arcs** (0x8B, 0x8C): along the circle through three poses, walked whole with
+//!   the inverse kinematics before the arm moves ([`motion`]).
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 
@@ -54,8 +58,10 @@ mod bank;
 pub mod cartesian;
 mod commands;
 pub mod config;
+pub mod drag;
 pub mod driver;
 pub mod error;
+mod gains;
 mod gripper;
 pub mod health;
 pub mod io;
