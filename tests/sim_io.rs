@@ -278,3 +278,30 @@ fn atom_inputs_read_their_pull_up_and_what_is_wired_to_them() {
         "an external pull-down beats the internal pull-up"
     );
 }
+
+#[test]
+fn move_round_turns_the_dispenser_servo_once_and_four_pieces_zero_stops_it() {
+    use firmware_atom::dispenser::{STOP_PULSE_US, TURN_PULSE_US, TURN_US};
+    let mut robot = arm();
+    let pulse = |robot: &VirtualRobot| robot.atom_io().accessory_servo_pulse_us;
+    assert_eq!(pulse(&robot), None, "no pulses before the first command");
+    ack(&mut robot, Request::MoveRound);
+    let started = robot.now_us();
+    assert_eq!(pulse(&robot), Some(TURN_PULSE_US), "turning clockwise");
+    robot.run_until(started + TURN_US - 20_000);
+    assert_eq!(pulse(&robot), Some(TURN_PULSE_US), "still turning");
+    robot.run_until(started + TURN_US + 20_000);
+    assert_eq!(
+        pulse(&robot),
+        Some(STOP_PULSE_US),
+        "one revolution, then still"
+    );
+    // Zero ends a turn at once.
+    ack(&mut robot, Request::MoveRound);
+    robot.run_for(100_000);
+    assert_eq!(pulse(&robot), Some(TURN_PULSE_US));
+    assert_eq!(ask(&mut robot, Request::SetFourPiecesZero), Reply::Byte(1));
+    assert_eq!(pulse(&robot), Some(STOP_PULSE_US));
+    robot.run_for(TURN_US);
+    assert_eq!(pulse(&robot), Some(STOP_PULSE_US));
+}

@@ -7,6 +7,7 @@
 //! * [`Gripper`]: the gripper's range and settings.
 //! * [`DragRecorder`]: drag teaching, fed from the bank's state reads.
 //! * [`Gains`]: the servos' position-loop gains (0x2C / 0x2D).
+//! * [`Dispenser`]: the accessory hobby servo (0xD4 / 0xD7).
 //! * [`ErrorLog`]: the error state 0x07 reports.
 //! * [`BusSchedule`]: who talks on the shared wire when; [`UsbLink`]: the Atom's own USB.
 //!
@@ -17,6 +18,7 @@ use protocol_core::{BytePort, Frame};
 
 use crate::bank::ServoBank;
 use crate::config::{AtomConfig, ConfigError, GRIPPER, JOINTS, JointLimit};
+use crate::dispenser::Dispenser;
 use crate::drag::DragRecorder;
 use crate::error::ErrorLog;
 use crate::gains::Gains;
@@ -43,6 +45,8 @@ pub(crate) struct Parts {
     pub drag: DragRecorder,
     /// The servos' gains.
     pub gains: Gains,
+    /// The accessory servo.
+    pub dispenser: Dispenser,
     /// The error state (0x07).
     pub errors: ErrorLog,
 }
@@ -72,6 +76,7 @@ impl Atom {
                 gripper: Gripper::new(&settings),
                 drag: DragRecorder::new(),
                 gains: Gains::default(),
+                dispenser: Dispenser::default(),
                 errors: ErrorLog::default(),
                 settings,
             },
@@ -117,6 +122,7 @@ impl Atom {
         let moved = motion.update(now_us, bank, settings);
         errors.note(moved).ok();
         self.parts.drag.poll(now_us, &self.parts.bank);
+        self.parts.dispenser.poll(now_us, io);
         self.update_button(now_us, io);
         self.schedule
             .start_next(now_us, bus, &mut self.parts.bank, &self.parts.settings);

@@ -100,6 +100,7 @@ fn execute<I: AtomIo>(
         gripper,
         drag,
         gains,
+        dispenser,
         errors,
     } = p;
     match request {
@@ -242,8 +243,8 @@ fn execute<I: AtomIo>(
             Ok(()) => Answer::Later,
             Err(e) => Answer::Done(Err(e)),
         },
-        // Vendor demo routines: not supported, refused.
-        R::MoveRound | R::SetFourPiecesZero => Answer::Now(Reply::Byte(0)),
+        R::MoveRound => Answer::Done(dispenser.turn(now_us, io)),
+        R::SetFourPiecesZero => byte(dispenser.zero(io)),
 
         // --- jog ---
         R::JogAngle {

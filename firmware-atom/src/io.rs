@@ -57,6 +57,13 @@ pub trait AtomIo {
     fn set_rgb(&mut self, red: u8, green: u8, blue: u8);
     /// True while the Atom's button (GPIO39, active low) is held down.
     fn button_pressed(&mut self) -> bool;
+    /// Sends the accessory hobby servo (on the Atom's Grove port, GPIO26; the Connect-4 kit's
+    /// dispenser, [`crate::dispenser`]) a `pulse_us`-long pulse every 20 ms, or no pulses
+    /// (`None`: the servo goes limp); `false` if the board has no such output (the default).
+    fn set_accessory_servo(&mut self, pulse_us: Option<u16>) -> bool {
+        let _ = pulse_us;
+        false
+    }
 }
 
 /// What is wired to a user pin outside the Atom, in a simulation ([`RecordingIo::set_wiring`]).
@@ -94,6 +101,8 @@ pub struct RecordingIo {
     pub rgb: (u8, u8, u8),
     /// Whether the button is held.
     pub button: bool,
+    /// Pulse the accessory servo gets every 20 ms, microseconds (`None`: no pulses).
+    pub accessory_servo_pulse_us: Option<u16>,
 }
 
 impl RecordingIo {
@@ -184,6 +193,11 @@ impl AtomIo for RecordingIo {
 
     fn button_pressed(&mut self) -> bool {
         self.button
+    }
+
+    fn set_accessory_servo(&mut self, pulse_us: Option<u16>) -> bool {
+        self.accessory_servo_pulse_us = pulse_us;
+        true
     }
 }
 

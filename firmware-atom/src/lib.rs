@@ -48,6 +48,8 @@
 //!   moved by hand; letting go holds it where it is.
 //! * **Drag teaching** (0xF1..0xF5): every joint's encoder and speed recorded 20 times a second
 //!   into 1 000 points, read back one point per request ([`drag`]).
+//! * **Move round** (0xD4) turns the accessory hobby servo (the Connect-4 kit's dispenser, on
+//!   the Grove port) one revolution; set four pieces zero (0xD7) stops it ([`dispenser`]).
 //! * **Circular arcs** (0x8B, 0x8C): along the circle through three poses, walked whole with
 //!   the inverse kinematics before the arm moves ([`motion`]).
 #![cfg_attr(not(test), no_std)]
@@ -58,6 +60,7 @@ mod bank;
 pub mod cartesian;
 mod commands;
 pub mod config;
+pub mod dispenser;
 pub mod drag;
 pub mod driver;
 pub mod error;

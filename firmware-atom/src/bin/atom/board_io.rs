@@ -1,4 +1,5 @@
-//! [`AtomIo`] on the chip: the user pins as GPIO or LEDC PWM, the RGB LEDs, the button.
+//! [`AtomIo`] on the chip: the user pins as GPIO or LEDC PWM, the RGB LEDs, the button, and on
+//! the ESP32 the accessory hobby servo on the Grove port (LEDC high-speed group).
 
 use esp_hal::{
     gpio::{DriveMode, Flex, Input, InputConfig, Level, NoPin, OutputSignal, Pull},
@@ -15,6 +16,8 @@ use crate::{
     leds::Leds,
     pwm::{duty_bits, duty_ticks},
 };
+#[cfg(feature = "esp32")]
+use esp_hal::ledc::{HighSpeed, timer::HSClockSource};
 
 /// Protocol number of the button pin, readable like a user input (`firmware_atom::io`).
 const BUTTON_PIN: u8 = 39;
@@ -31,6 +34,59 @@ pub struct UserPin<'d> {
     pub signal: OutputSignal,
 }
 
+/// The accessory hobby servo's pin (GPIO26, the Grove port) and the LEDC high-speed timer that
+/// times its 50 Hz pulses, with high-speed channel 0 (no user pin uses the high-speed group).
+#[cfg(feature = "esp32")]
+pub struct AccessoryServo<'d> {
+    /// The pin.
+    pub gpio: Flex<'d>,
+    /// High-speed timer 0.
+    pub timer: Timer<'d, HighSpeed>,
+}
+
+#[cfg(feature = "esp32")]
+impl AccessoryServo<'_> {
+    /// Pulses of `pulse_us` every 20 ms, or none (the pin a floating input again).
+    fn set(&mut self, pulse_us: Option<u16>) -> bool {
+        let signal = OutputSignal::LEDC_HS_SIG0;
+        let Some(pulse_us) = pulse_us else {
+            signal.disconnect_from(&self.gpio);
+            make_input(&mut self.gpio, Pull::None);
+            return true;
+        };
+        let freq_hz = crate::pwm::SERVO_FREQ_HZ;
+        let Some(bits) = duty_bits(freq_hz) else {
+            return false;
+        };
+        let Ok(duty) = timer::config::Duty::try_from(bits) else {
+            return false;
+        };
+        if !self.timer.is_configured() {
+            let config = timer::config::Config {
+                duty,
+                clock_source: HSClockSource::APBClk,
+                frequency: Rate::from_hz(u32::from(freq_hz)),
+            };
+            if self.timer.configure(config).is_err() {
+                return false;
+            }
+        }
+        let mut pwm = channel::Channel::<HighSpeed>::new(channel::Number::Channel0, NoPin);
+        let channel_config = channel::config::Config {
+            timer: &self.timer,
+            duty_pct: 0,
+            drive_mode: DriveMode::PushPull,
+        };
+        if pwm.configure(channel_config).is_err() {
+            return false;
+        }
+        pwm.set_duty_hw(crate::pwm::pulse_ticks(pulse_us, bits));
+        signal.connect_to(&self.gpio);
+        self.gpio.set_output_enable(true);
+        true
+    }
+}
+
 /// The Atom's board IO.
 pub struct BoardIo<'d> {
     /// The user pins, in the order of [`OUTPUT_PINS`].
@@ -39,6 +95,9 @@ pub struct BoardIo<'d> {
     pwm_on: [bool; 4],
     leds: Option<Leds<'d>>,
     button: Input<'d>,
+    /// The accessory hobby servo (ESP32 only).
+    #[cfg(feature = "esp32")]
+    accessory: Option<AccessoryServo<'d>>,
 }
 
 impl<'d> BoardIo<'d> {
@@ -53,7 +112,18 @@ impl<'d> BoardIo<'d> {
             pwm_on: [false; 4],
             leds,
             button,
+            #[cfg(feature = "esp32")]
+            accessory: None,
         }
+    }
+
+    /// The same IO with the accessory hobby servo on `servo`; its pin starts as a floating
+    /// input (no pulses, the servo limp).
+    #[cfg(feature = "esp32")]
+    pub fn with_accessory(mut self, mut servo: AccessoryServo<'d>) -> Self {
+        make_input(&mut servo.gpio, Pull::None);
+        self.accessory = Some(servo);
+        self
     }
 
     /// The user pin with protocol number `pin`, and whether it outputs PWM.
@@ -156,5 +226,10 @@ impl AtomIo for BoardIo<'_> {
 
     fn button_pressed(&mut self) -> bool {
         self.button.is_low()
+    }
+
+    #[cfg(feature = "esp32")]
+    fn set_accessory_servo(&mut self, pulse_us: Option<u16>) -> bool {
+        self.accessory.as_mut().is_some_and(|a| a.set(pulse_us))
     }
 }

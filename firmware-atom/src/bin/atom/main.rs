@@ -85,7 +85,13 @@ fn main() -> ! {
         board_log!("RMT refused the LED channel; LEDs stay dark");
     }
     let button = Input::new(pins.button, InputConfig::default().with_pull(Pull::None));
-    let mut io = BoardIo::new(user, leds, button);
+    let io = BoardIo::new(user, leds, button);
+    #[cfg(feature = "esp32")]
+    let io = io.with_accessory(board_io::AccessoryServo {
+        gpio: Flex::new(pins.accessory),
+        timer: ledc.timer::<esp_hal::ledc::HighSpeed>(timer::Number::Timer0),
+    });
+    let mut io = io;
 
     let mut atom = Atom::new(AtomConfig::default());
     if let Some(error) = atom.config_error() {
