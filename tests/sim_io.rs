@@ -240,13 +240,8 @@ fn atom_inputs_read_their_pull_up_and_what_is_wired_to_them() {
         Reply::PinLevel { pin: 22, high } => high,
         other => panic!("get_digital_input(22) answered {other:?}"),
     };
-    ack(
-        &mut robot,
-        Request::SetPinMode {
-            pin,
-            mode: PinMode::InputPullUp,
-        },
-    );
+    let set_mode = |robot: &mut VirtualRobot, mode| ack(robot, Request::SetPinMode { pin, mode });
+    set_mode(&mut robot, PinMode::InputPullUp);
     assert!(
         read(&mut robot),
         "an open input with its pull-up reads high"
@@ -255,24 +250,12 @@ fn atom_inputs_read_their_pull_up_and_what_is_wired_to_them() {
     assert!(robot.atom_io_mut().set_input(22, false));
     assert!(!read(&mut robot));
     assert!(robot.atom_io_mut().set_wiring(22, Wiring::Open));
-    ack(
-        &mut robot,
-        Request::SetPinMode {
-            pin,
-            mode: PinMode::Input,
-        },
-    );
+    set_mode(&mut robot, PinMode::Input);
     assert!(!read(&mut robot), "floating, no pull: low");
     assert!(robot.atom_io_mut().set_wiring(22, Wiring::PullUp));
     assert!(read(&mut robot), "an external pull-up");
     assert!(robot.atom_io_mut().set_wiring(22, Wiring::PullDown));
-    ack(
-        &mut robot,
-        Request::SetPinMode {
-            pin,
-            mode: PinMode::InputPullUp,
-        },
-    );
+    set_mode(&mut robot, PinMode::InputPullUp);
     assert!(
         !read(&mut robot),
         "an external pull-down beats the internal pull-up"

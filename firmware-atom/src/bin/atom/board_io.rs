@@ -6,7 +6,7 @@ use esp_hal::{
     ledc::{
         LowSpeed,
         channel::{self, ChannelHW, ChannelIFace},
-        timer::{self, LSClockSource, Timer, TimerIFace},
+        timer::{self, LSClockSource, Timer, TimerIFace, TimerSpeed},
     },
     time::Rate,
 };
@@ -54,36 +54,15 @@ impl AccessoryServo<'_> {
             make_input(&mut self.gpio, Pull::None);
             return true;
         };
-        let freq_hz = crate::pwm::SERVO_FREQ_HZ;
-        let Some(bits) = duty_bits(freq_hz) else {
-            return false;
-        };
-        let Ok(duty) = timer::config::Duty::try_from(bits) else {
-            return false;
-        };
-        if !self.timer.is_configured() {
-            let config = timer::config::Config {
-                duty,
-                clock_source: HSClockSource::APBClk,
-                frequency: Rate::from_hz(u32::from(freq_hz)),
-            };
-            if self.timer.configure(config).is_err() {
-                return false;
-            }
-        }
-        let mut pwm = channel::Channel::<HighSpeed>::new(channel::Number::Channel0, NoPin);
-        let channel_config = channel::config::Config {
-            timer: &self.timer,
-            duty_pct: 0,
-            drive_mode: DriveMode::PushPull,
-        };
-        if pwm.configure(channel_config).is_err() {
-            return false;
-        }
-        pwm.set_duty_hw(crate::pwm::pulse_ticks(pulse_us, bits));
-        signal.connect_to(&self.gpio);
-        self.gpio.set_output_enable(true);
-        true
+        start_pwm(
+            &mut self.gpio,
+            signal,
+            &mut self.timer,
+            HSClockSource::APBClk,
+            channel::Number::Channel0,
+            crate::pwm::SERVO_FREQ_HZ,
+            |bits| crate::pwm::pulse_ticks(pulse_us, bits),
+        )
     }
 }
 
@@ -141,6 +120,52 @@ impl<'d> BoardIo<'d> {
     }
 }
 
+/// Starts PWM on `gpio`: `timer` at `freq_hz` from `clock` with the finest duty resolution the
+/// clock allows, LEDC channel `number` at the duty `ticks` gives for that resolution (bits), its
+/// `signal` routed to the pin through the GPIO matrix. `false` if the LEDC refuses.
+fn start_pwm<'d, S>(
+    gpio: &mut Flex<'d>,
+    signal: OutputSignal,
+    timer: &mut Timer<'d, S>,
+    clock: S::ClockSourceType,
+    number: channel::Number,
+    freq_hz: u16,
+    ticks: impl FnOnce(u32) -> u32,
+) -> bool
+where
+    S: TimerSpeed,
+    Timer<'d, S>: TimerIFace<S>,
+{
+    let Some(bits) = duty_bits(freq_hz) else {
+        return false;
+    };
+    let Ok(duty) = timer::config::Duty::try_from(bits) else {
+        return false;
+    };
+    let timer_config = timer::config::Config {
+        duty,
+        clock_source: clock,
+        frequency: Rate::from_hz(u32::from(freq_hz)),
+    };
+    if timer.configure(timer_config).is_err() {
+        return false;
+    }
+    // The channel's signal is routed to the pin by hand below, so the driver gets no pin.
+    let mut pwm = channel::Channel::<S>::new(number, NoPin);
+    let channel_config = channel::config::Config {
+        timer: &*timer,
+        duty_pct: 0,
+        drive_mode: DriveMode::PushPull,
+    };
+    if pwm.configure(channel_config).is_err() {
+        return false;
+    }
+    pwm.set_duty_hw(ticks(bits));
+    signal.connect_to(&*gpio);
+    gpio.set_output_enable(true);
+    true
+}
+
 fn make_input(gpio: &mut Flex<'_>, pull: Pull) {
     gpio.set_output_enable(false);
     gpio.apply_input_config(&InputConfig::default().with_pull(pull));
@@ -184,38 +209,20 @@ impl AtomIo for BoardIo<'_> {
     }
 
     fn set_pwm(&mut self, pin: u8, freq_hz: u16, duty_0_255: u8) -> bool {
-        let Some(bits) = duty_bits(freq_hz) else {
-            return false;
-        };
-        let Ok(duty) = timer::config::Duty::try_from(bits) else {
-            return false;
-        };
         let Some((user, pwm_on)) = self.user_pin(pin) else {
             return false;
         };
-        let timer_config = timer::config::Config {
-            duty,
-            clock_source: LSClockSource::APBClk,
-            frequency: Rate::from_hz(u32::from(freq_hz)),
-        };
-        if user.timer.configure(timer_config).is_err() {
-            return false;
-        }
-        // The channel's signal is routed to the pin by hand below, so the driver gets no pin.
-        let mut pwm = channel::Channel::new(user.channel, NoPin);
-        let channel_config = channel::config::Config {
-            timer: &user.timer,
-            duty_pct: 0,
-            drive_mode: DriveMode::PushPull,
-        };
-        if pwm.configure(channel_config).is_err() {
-            return false;
-        }
-        pwm.set_duty_hw(duty_ticks(duty_0_255, bits));
-        user.signal.connect_to(&user.gpio);
-        user.gpio.set_output_enable(true);
-        *pwm_on = true;
-        true
+        let on = start_pwm(
+            &mut user.gpio,
+            user.signal,
+            &mut user.timer,
+            LSClockSource::APBClk,
+            user.channel,
+            freq_hz,
+            |bits| duty_ticks(duty_0_255, bits),
+        );
+        *pwm_on |= on;
+        on
     }
 
     fn set_rgb(&mut self, red: u8, green: u8, blue: u8) {
