@@ -6,6 +6,7 @@ mod sim_support;
 
 use open_mycobot::sim::measure;
 use open_mycobot::sim::{HostLink, VirtualRobot};
+use protocol_core::command::{Reply, Request};
 use protocol_core::servo::reg;
 use protocol_core::timing::HOST_REPLY_DEADLINE_US;
 use protocol_core::{Frame, FrameDecoder};
@@ -127,6 +128,11 @@ fn get_pid_answers_the_factory_gains_and_255_for_a_missing_servo() {
     let reply = send(&mut robot, &basic_frame(0x2D, &[]));
     // Joint 1 (10, 0, 1 as P, D, I) and joint 4 (32, 32, 0), in P, I, D order.
     assert_eq!(reply.data(), [10, 1, 0, 32, 0, 32]);
+    // The same through the Basic, whose bus the reply shares with the servo reads.
+    assert_eq!(
+        ask(&mut robot, Request::GetPid),
+        Reply::Bytes6([10, 1, 0, 32, 0, 32])
+    );
     robot
         .servo_mut(4)
         .expect("servo 4")

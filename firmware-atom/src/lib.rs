@@ -52,6 +52,9 @@
 //!   the Grove port) one revolution; set four pieces zero (0xD7) stops it ([`dispenser`]).
 //! * **Circular arcs** (0x8B, 0x8C): along the circle through three poses, walked whole with
 //!   the inverse kinematics before the arm moves ([`motion`]).
+//! * **MyCobotBasic's layouts**: send coord's axis byte 0 is x (the seed manual's numbering; 1..6
+//!   stay pymycobot's x..rz); set / get PID (0x2C / 0x2D) write and read the joint servos' P, I,
+//!   D registers, six bytes for joints 1..3 and 4..6.
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 
