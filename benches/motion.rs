@@ -10,14 +10,17 @@
 //!   clean stop at its last target.
 //! * **Lines**: send_coords mode 1 and jog_coord at speed 50: the flange's largest distance from
 //!   the straight segment, and its largest turn from the orientation.
+//! * **Arcs**: move_c_coords (0x8C) from the present pose through two more at speed 50 and 100:
+//!   the flange's largest distance from the circle through the three poses, how close it passes
+//!   the middle one, and where it ends.
 //!
-//! `cargo bench --bench motion [stop|stream|line]`. Figures, not pass/fail; targets are printed
+//! `cargo bench --bench motion [stop|stream|line|arc]`. Figures, not pass/fail; targets are printed
 //! next to them. `MOTION_TRACE=1` also prints each line's distance from its segment over time.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
 use std::f64::consts::TAU;
 
-use open_mycobot::sim::measure::{self, FlangePose};
+use open_mycobot::sim::measure::{self, Circle, FlangePose};
 use open_mycobot::sim::{RobotConfig, VirtualRobot};
 use protocol_core::command::{Axis, Direction, JointId, MoveMode, Pose, Reply, Request};
 use protocol_core::timing::{HOST_BAUD, wire_time_us};
@@ -408,6 +411,82 @@ fn lines() {
     }
 }
 
+/// Where the flange goes, sampled every [`SAMPLE_US`] until the arm stops (at most 10 s).
+fn trace_until_still(robot: &mut VirtualRobot) -> Vec<FlangePose> {
+    let mut trace = vec![measure::flange(&robot.shaft_angles_deg())];
+    for _ in 0..(10_000_000 / SAMPLE_US) {
+        robot.run_for(SAMPLE_US);
+        trace.push(measure::flange(&robot.shaft_angles_deg()));
+        if trace.len() > 40 && !robot.atom().is_moving() {
+            break;
+        }
+    }
+    trace
+}
+
+fn arcs() {
+    println!(
+        "== circular arcs, move_c_coords from here (target: within 0.15 mm of the circle, as lines)"
+    );
+    let start_angles = [10.0, -30.0, -50.0, -10.0, 10.0, 20.0];
+    // (middle, end) as offsets from the start, mm.
+    let arcs: [([f64; 3], [f64; 3]); 3] = [
+        ([-40.0, 40.0, 10.0], [0.0, 80.0, 0.0]),
+        ([-30.0, 0.0, 30.0], [-60.0, 0.0, 0.0]),
+        ([-20.0, -20.0, 0.0], [-60.0, 10.0, 20.0]),
+    ];
+    let shifted = |p: &Pose, d: &[f64; 3]| Pose {
+        x: DeciMm(p.x.0 + (d[0] * 10.0) as i16),
+        y: DeciMm(p.y.0 + (d[1] * 10.0) as i16),
+        z: DeciMm(p.z.0 + (d[2] * 10.0) as i16),
+        ..*p
+    };
+    let mm = |p: &Pose| [p.x.0, p.y.0, p.z.0].map(|v| f64::from(v) / 10.0);
+    for percent in [50, 100] {
+        for (middle, end) in &arcs {
+            let mut robot = booted();
+            move_to(&mut robot, start_angles);
+            let start = measure::flange(&robot.shaft_angles_deg());
+            let Reply::Coords(from) = ask(&mut robot, Request::GetCoords) else {
+                panic!("get_coords")
+            };
+            let (middle, end) = (shifted(&from, middle), shifted(&from, end));
+            let Some(circle) = Circle::through(&start.position_mm, &mm(&middle), &mm(&end)) else {
+                println!("no circle through {from:?} {middle:?} {end:?}");
+                continue;
+            };
+            ask(
+                &mut robot,
+                Request::SetSpeed {
+                    speed: speed(percent),
+                },
+            );
+            let reply = robot.ask(&Request::MoveCCoordsFromHere { middle, end });
+            if reply != Ok(Reply::Ack) {
+                println!("arc through {middle:?} to {end:?} refused: {reply:?}");
+                continue;
+            }
+            let trace = trace_until_still(&mut robot);
+            let off = trace
+                .iter()
+                .map(|p| circle.distance_mm(&p.position_mm))
+                .fold(0.0, f64::max);
+            let passes = trace
+                .iter()
+                .map(|p| measure::distance_mm(&p.position_mm, &mm(&middle)))
+                .fold(f64::MAX, f64::min);
+            let ends = trace.last().map_or(f64::NAN, |p| {
+                measure::distance_mm(&p.position_mm, &mm(&end))
+            });
+            println!(
+                "arc r {:5.1} mm at {percent:>3} %: off the circle by at most {off:.3} mm, passes \
+                 {passes:.3} mm from the middle, ends {ends:.3} mm from the end",
+                circle.radius_mm
+            );
+        }
+    }
+}
+
 fn main() {
     let only = std::env::args().nth(1).filter(|a| !a.starts_with('-'));
     let want = |name: &str| only.as_deref().is_none_or(|o| o == name);
@@ -420,5 +499,8 @@ fn main() {
     }
     if want("line") {
         lines();
+    }
+    if want("arc") {
+        arcs();
     }
 }

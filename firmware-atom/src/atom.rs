@@ -5,6 +5,9 @@
 //!   through the safety check).
 //! * [`MotionController`]: moves, paths, streams, jogs, braking, the queue.
 //! * [`Gripper`]: the gripper's range and settings.
+//! * [`DragRecorder`]: drag teaching, fed from the bank's state reads.
+//! * [`Gains`]: the servos' position-loop gains (0x2C / 0x2D).
+//! * [`Dispenser`]: the accessory hobby servo (0xD4 / 0xD7).
 //! * [`ErrorLog`]: the error state 0x07 reports.
 //! * [`BusSchedule`]: who talks on the shared wire when; [`UsbLink`]: the Atom's own USB.
 //!
@@ -16,7 +19,10 @@ use protocol_core::{BytePort, Frame};
 use crate::backup::Backups;
 use crate::bank::{Completion, ServoBank};
 use crate::config::{AtomConfig, ConfigError, GRIPPER, JOINTS, JointLimit};
+use crate::dispenser::Dispenser;
+use crate::drag::DragRecorder;
 use crate::error::ErrorLog;
+use crate::gains::Gains;
 use crate::gripper::Gripper;
 use crate::health::ServoHealth;
 use crate::io::AtomIo;
@@ -36,6 +42,12 @@ pub(crate) struct Parts {
     pub motion: MotionController,
     /// The gripper.
     pub gripper: Gripper,
+    /// Drag teaching.
+    pub drag: DragRecorder,
+    /// The servos' gains.
+    pub gains: Gains,
+    /// The accessory servo.
+    pub dispenser: Dispenser,
     /// The error state (0x07).
     pub errors: ErrorLog,
     /// Servo parameter backups (0xEA/0xEB).
@@ -65,6 +77,9 @@ impl Atom {
                 bank: ServoBank::new(&settings),
                 motion: MotionController::new(),
                 gripper: Gripper::new(&settings),
+                drag: DragRecorder::new(),
+                gains: Gains::default(),
+                dispenser: Dispenser::default(),
                 errors: ErrorLog::default(),
                 backups: Backups::default(),
                 settings,
@@ -110,6 +125,8 @@ impl Atom {
         } = &mut self.parts;
         let moved = motion.update(now_us, bank, settings);
         errors.note(moved).ok();
+        self.parts.drag.poll(now_us, &self.parts.bank);
+        self.parts.dispenser.poll(now_us, io);
         self.update_button(now_us, io);
         self.schedule
             .start_next(now_us, bus, &mut self.parts.bank, &self.parts.settings);
@@ -175,7 +192,12 @@ impl Atom {
     ) {
         let corrupt = self.schedule.saw_corruption();
         let p = &mut self.parts;
-        let reply = match p.bank.finish(&p.settings, op, outcome, corrupt) {
+        let finished = p
+            .bank
+            .finish(&p.settings, op.clone(), outcome.clone(), corrupt);
+        let retrying = p.bank.due_job().as_ref() == Some(&op);
+        let gains = p.gains.finished(&op, &outcome, retrying);
+        let reply = match finished {
             Some(Completion::Reply { link, reply }) => Some((link, reply)),
             Some(Completion::Params { index, block }) => p.backups.on_block(
                 now_us,
@@ -188,10 +210,11 @@ impl Atom {
             ),
             None => None,
         };
-        match reply {
-            Some((Link::Bus, reply)) => self.schedule.send_reply(reply),
-            Some((Link::Usb, reply)) => usb.write(&reply.to_bytes()),
-            None => {}
+        for (link, reply) in reply.into_iter().chain(gains) {
+            match link {
+                Link::Bus => self.schedule.send_reply(reply),
+                Link::Usb => usb.write(&reply.to_bytes()),
+            }
         }
     }
 
@@ -276,5 +299,11 @@ impl Atom {
     /// type) and the kinematics model they configure, as coordinates are reported with.
     pub fn cartesian(&self) -> &crate::cartesian::Cartesian {
         self.parts.settings.cart()
+    }
+
+    /// Drag-teaching points recorded (0xF4), and whether it is still recording (a full buffer
+    /// stops it).
+    pub fn drag_record(&self) -> (u16, bool) {
+        (self.parts.drag.recorded(), self.parts.drag.is_recording())
     }
 }

@@ -251,6 +251,11 @@ impl ServoBank {
             .unwrap_or([None; SERVOS]);
         for (i, (slot, new)) in merged.iter_mut().zip(safe.goals()).enumerate() {
             if let Some(g) = new {
+                // A released servo is switched on first (holding where it is, until the goal
+                // is written): the goal below then replaces that hold as what it was told.
+                if self.health.get(i).is_some_and(|h| !h.torque_on) {
+                    self.set_torque(settings, i, true);
+                }
                 *slot = Some(*g);
                 if let Some(c) = self.commanded.get_mut(i) {
                     *c = true;
@@ -263,9 +268,6 @@ impl ServoBank {
                 }
                 if let Some(t) = self.goal_sent_us.get_mut(i) {
                     *t = self.now_us;
-                }
-                if self.health.get(i).is_some_and(|h| !h.torque_on) {
-                    self.set_torque(settings, i, true);
                 }
             }
         }

@@ -22,7 +22,7 @@ use crate::error::AtomError;
 use crate::health::ServoHealth;
 use crate::io::{AtomIo, PinMode, is_output_pin};
 use crate::link::Link;
-use crate::motion::{JogDirection, Target, angles_match};
+use crate::motion::{JogDirection, Target, Way, angles_match};
 use crate::registers::{self, ServoAccess};
 
 /// Reported by get system version (0x02): 7.0, the vendor's 280 M5 generation.
@@ -98,6 +98,9 @@ fn execute<I: AtomIo>(
         bank,
         motion,
         gripper,
+        drag,
+        gains,
+        dispenser,
         errors,
         ..
     } = p;
@@ -227,8 +230,31 @@ fn execute<I: AtomIo>(
         }
         R::GetPlannedAngles => Answer::Now(Reply::Angles(motion.planned_angles(bank, settings))),
         R::GetPlannedCoords => Answer::Now(Reply::Coords(for_client(planned_pose(p)))),
-        // Vendor demo routines: not supported, refused.
-        R::MoveRound | R::SetFourPiecesZero => Answer::Now(Reply::Byte(0)),
+        R::MoveCCoords { begin, middle, end } => Answer::Done(motion.submit_arc(
+            now_us,
+            Some(begin),
+            middle,
+            end,
+            settings.speed_percent(),
+            bank,
+            settings,
+        )),
+        R::MoveCCoordsFromHere { middle, end } => Answer::Done(motion.submit_arc(
+            now_us,
+            None,
+            middle,
+            end,
+            settings.speed_percent(),
+            bank,
+            settings,
+        )),
+        R::SetPid { gains: values } => Answer::Done(gains.set(bank, settings, values)),
+        R::GetPid => match gains.read(bank, settings, link) {
+            Ok(()) => Answer::Later,
+            Err(e) => Answer::Done(Err(e)),
+        },
+        R::MoveRound => Answer::Done(dispenser.turn(now_us, io)),
+        R::SetFourPiecesZero => byte(dispenser.zero(io)),
 
         // --- jog ---
         R::JogAngle {
@@ -476,6 +502,13 @@ fn execute<I: AtomIo>(
             done()
         }
 
+        // --- drag teaching ---
+        R::DragStartRecord => Answer::Now(Reply::Int16(count(drag.start(now_us)))),
+        R::DragEndRecord => Answer::Now(Reply::Int16(count(drag.end()))),
+        R::DragGetRecordData => Answer::Now(Reply::DragPoint(drag.next_point())),
+        R::DragGetRecordLen => Answer::Now(Reply::Int16(count(drag.recorded()))),
+        R::DragClearRecordData => Answer::Now(Reply::Int16(count(drag.clear()))),
+
         // --- coordinate frames ---
         R::SetToolReference { pose } => {
             let cart = settings.cart_mut();
@@ -515,7 +548,7 @@ fn execute<I: AtomIo>(
         })),
 
         // The Basic answers these itself; one reaching the Atom (a client on the Atom's own
-        // USB) is refused. Drag teaching is not supported.
+        // USB) is refused.
         R::SetBasicOutput { .. }
         | R::GetBasicInput { .. }
         | R::SetSsidPwd { .. }
@@ -524,12 +557,7 @@ fn execute<I: AtomIo>(
         | R::GetTofDistance
         | R::GetBasicVersion
         | R::SetTransponderMode { .. }
-        | R::GetTransponderMode
-        | R::DragStartRecord
-        | R::DragEndRecord
-        | R::DragGetRecordData
-        | R::DragGetRecordLen
-        | R::DragClearRecordData => Answer::Now(Reply::Byte(0)),
+        | R::GetTransponderMode => Answer::Now(Reply::Byte(0)),
     }
 }
 
@@ -573,7 +601,10 @@ fn move_to_pose(
     let target = Target {
         angles: angles.map(Some),
         speed_percent,
-        line: (mode == MoveMode::Linear).then_some(pose),
+        way: match mode {
+            MoveMode::Linear => Way::Line(pose),
+            MoveMode::Joint => Way::Joints,
+        },
     };
     p.motion.submit(now_us, target, &mut p.bank, &p.settings)
 }
@@ -585,6 +616,11 @@ fn one_joint(j: usize, angle: Centideg) -> [Option<Centideg>; JOINTS] {
         *slot = Some(angle);
     }
     angles
+}
+
+/// A count of drag-teaching points as the int16 the host reads (at most 1 000).
+fn count(n: u16) -> i16 {
+    i16::try_from(n).unwrap_or(i16::MAX)
 }
 
 fn dir(d: Direction) -> JogDirection {

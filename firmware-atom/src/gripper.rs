@@ -1,5 +1,9 @@
 //! The gripper (servo 7): its opening 0 (closed) ..= 100 (open) mapped linearly onto an encoder
 //! range, and the settings the gripper commands read back.
+//!
+//! Speed 0 means stop (pymycobot's `gripper_stop` sends set gripper value 0 at speed 0): the
+//! gripper holds where it is, whatever the value. After a release (state 254) the next command
+//! switches the servo on before its goal is written, so that command moves it.
 
 use protocol_core::command::GripperState;
 use protocol_core::units::Steps;
@@ -40,7 +44,7 @@ impl Gripper {
         ((pos - closed) * 100 / span).clamp(0, 100) as u8
     }
 
-    /// Opens (100), closes (0) or releases the gripper (0x66).
+    /// Opens (100), closes (0) or releases the gripper (0x66); speed 0 stops it where it is.
     pub fn set_state(
         &self,
         bank: &mut ServoBank,
@@ -61,7 +65,7 @@ impl Gripper {
         }
     }
 
-    /// Moves the gripper to opening `value` 0..=100 (0x67).
+    /// Moves the gripper to opening `value` 0..=100 (0x67); speed 0 stops it where it is.
     pub fn move_to(
         &self,
         bank: &mut ServoBank,
@@ -69,6 +73,9 @@ impl Gripper {
         value: u8,
         speed_percent: u8,
     ) -> Result<(), AtomError> {
+        if speed_percent == 0 {
+            return stop(bank, settings);
+        }
         let closed = i32::from(self.range.closed.0);
         let open = i32::from(self.range.open.0);
         let steps = closed + (open - closed) * i32::from(value.min(100)) / 100;
@@ -104,7 +111,21 @@ impl Gripper {
     }
 }
 
-/// Moves the gripper servo to an encoder position at `speed_percent` of the joint speed.
+/// Stops the gripper where it is: braking at the servo's full deceleration, the goal where it
+/// comes to rest. A released gripper stays released.
+fn stop(bank: &mut ServoBank, settings: &Settings) -> Result<(), AtomError> {
+    let mut goals: GoalSet = [None; SERVOS];
+    if let Some(slot) = goals.get_mut(GRIPPER) {
+        *slot = crate::motion::stop_one(bank, settings, GRIPPER);
+    }
+    if goals.iter().all(Option::is_none) {
+        return Ok(());
+    }
+    bank.send_goals(settings, goals)
+}
+
+/// Moves the gripper servo to an encoder position at `speed_percent` of the joint speed (a
+/// released gripper is switched on by the bank before its goal is written).
 pub fn move_steps(
     bank: &mut ServoBank,
     settings: &Settings,

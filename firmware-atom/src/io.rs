@@ -61,26 +61,56 @@ pub trait AtomIo {
     fn param_store(&mut self) -> Option<&mut dyn crate::backup::ParamStore> {
         None
     }
+
+    /// Sends the accessory hobby servo (on the Atom's Grove port, GPIO26; the Connect-4 kit's
+    /// dispenser, [`crate::dispenser`]) a `pulse_us`-long pulse every 20 ms, or no pulses
+    /// (`None`: the servo goes limp); `false` if the board has no such output (the default).
+    fn set_accessory_servo(&mut self, pulse_us: Option<u16>) -> bool {
+        let _ = pulse_us;
+        false
+    }
 }
 
 /// Flash of the parameter backups in [`RecordingIo`]: four 4 KiB pages.
 pub type MemParams = crate::backup::FlashParams<flash_store::MemFlash<{ 4 * 4096 }>>;
 
-/// An [`AtomIo`] that remembers what it was told, for tests and the virtual robot: pins read
-/// back what was written (inputs read low unless set with [`RecordingIo::set_input`]), and
-/// parameter backups kept in flash in RAM (which outlives a reset of the Atom).
+/// What is wired to a user pin outside the Atom, in a simulation ([`RecordingIo::set_wiring`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Wiring {
+    /// Nothing: an input reads its internal pull (high with [`PinMode::InputPullUp`]), and low
+    /// without one (a floating CMOS input is undefined; the model picks low).
+    #[default]
+    Open,
+    /// A device drives the pin high (`true`) or low; it wins over any pull.
+    Driven(bool),
+    /// An external pull-up resistor: the pin reads high unless something drives it.
+    PullUp,
+    /// An external pull-down resistor (a few kohm, stronger than the ESP32's ~45 kohm internal
+    /// pull-up): the pin reads low unless something drives it.
+    PullDown,
+}
+
+/// An [`AtomIo`] that remembers what it was told, for tests and the virtual robot. A user pin
+/// reads what it outputs in output mode; as an input it reads what is wired to it
+/// ([`Wiring`]): a driving device, else an external pull, else its internal pull-up (mode 2),
+/// else low. Parameter backups are kept in flash in RAM, which outlives a reset of the Atom.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RecordingIo {
-    /// Mode of each user pin, indexed like [`INPUT_PINS`].
+    /// Mode of each user pin, indexed like [`INPUT_PINS`] (`None`: as after reset, a floating
+    /// input).
     pub modes: [Option<PinMode>; 5],
-    /// Level of each user pin, indexed like [`INPUT_PINS`].
+    /// Level each user pin outputs in output mode, indexed like [`INPUT_PINS`].
     pub levels: [bool; 5],
+    /// What is wired to each user pin outside the Atom, indexed like [`INPUT_PINS`].
+    pub wiring: [Wiring; 5],
     /// Last PWM setting of each output pin (frequency in Hz, duty 0..255), like [`OUTPUT_PINS`].
     pub pwm: [Option<(u16, u8)>; 4],
     /// Last colour set on the LEDs (red, green, blue).
     pub rgb: (u8, u8, u8),
     /// Whether the button is held.
     pub button: bool,
+    /// Pulse the accessory servo gets every 20 ms, microseconds (`None`: no pulses).
+    pub accessory_servo_pulse_us: Option<u16>,
     /// The servo parameter backups' flash.
     pub params: MemParams,
 }
@@ -93,17 +123,25 @@ impl Default for RecordingIo {
             pwm: Default::default(),
             rgb: Default::default(),
             button: false,
+            wiring: Default::default(),
+            accessory_servo_pulse_us: None,
             params: MemParams::new(flash_store::MemFlash::new(), 0..4 * 4096),
         }
     }
 }
 
 impl RecordingIo {
-    /// Sets the level an input pin reads; `false` if `pin` is not a user pin.
+    /// A device drives user pin `pin` high or low (it then reads that level as an input);
+    /// `false` if `pin` is not a user pin.
     pub fn set_input(&mut self, pin: u8, high: bool) -> bool {
-        match slot(pin).and_then(|i| self.levels.get_mut(i)) {
-            Some(level) => {
-                *level = high;
+        self.set_wiring(pin, Wiring::Driven(high))
+    }
+
+    /// Wires `what` to user pin `pin`; `false` if `pin` is not a user pin.
+    pub fn set_wiring(&mut self, pin: u8, what: Wiring) -> bool {
+        match slot(pin).and_then(|i| self.wiring.get_mut(i)) {
+            Some(w) => {
+                *w = what;
                 true
             }
             None => false,
@@ -129,15 +167,35 @@ impl AtomIo for RecordingIo {
         }
     }
 
+    /// Like the board, writing a level makes the pin an output.
     fn write_pin(&mut self, pin: u8, high: bool) -> bool {
-        is_output_pin(pin) && self.set_input(pin, high)
+        if !is_output_pin(pin) {
+            return false;
+        }
+        let Some(i) = slot(pin) else { return false };
+        if let (Some(level), Some(mode)) = (self.levels.get_mut(i), self.modes.get_mut(i)) {
+            *level = high;
+            *mode = Some(PinMode::Output);
+            return true;
+        }
+        false
     }
 
     fn read_pin(&mut self, pin: u8) -> Option<bool> {
         if pin == 39 {
             return Some(!self.button);
         }
-        slot(pin).and_then(|i| self.levels.get(i).copied())
+        let i = slot(pin)?;
+        let mode = self.modes.get(i).copied().flatten();
+        if mode == Some(PinMode::Output) {
+            return self.levels.get(i).copied();
+        }
+        Some(match self.wiring.get(i).copied().unwrap_or_default() {
+            Wiring::Driven(high) => high,
+            Wiring::PullUp => true,
+            Wiring::PullDown => false,
+            Wiring::Open => mode == Some(PinMode::InputPullUp),
+        })
     }
 
     fn set_pwm(&mut self, pin: u8, freq_hz: u16, duty_0_255: u8) -> bool {
@@ -164,5 +222,41 @@ impl AtomIo for RecordingIo {
 
     fn param_store(&mut self) -> Option<&mut dyn crate::backup::ParamStore> {
         Some(&mut self.params)
+    }
+
+    fn set_accessory_servo(&mut self, pulse_us: Option<u16>) -> bool {
+        self.accessory_servo_pulse_us = pulse_us;
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inputs_read_their_pulls_and_what_drives_them() {
+        let mut io = RecordingIo::default();
+        assert_eq!(io.read_pin(22), Some(false), "floating after reset");
+        assert!(io.set_pin_mode(22, PinMode::InputPullUp));
+        assert_eq!(io.read_pin(22), Some(true), "internal pull-up");
+        assert!(io.set_wiring(22, Wiring::PullDown));
+        assert_eq!(
+            io.read_pin(22),
+            Some(false),
+            "a stronger external pull-down"
+        );
+        assert!(io.set_input(22, true));
+        assert_eq!(io.read_pin(22), Some(true), "driven high");
+        assert!(io.set_wiring(22, Wiring::Open));
+        assert!(io.set_pin_mode(22, PinMode::Input));
+        assert_eq!(io.read_pin(22), Some(false), "floating again");
+        assert!(io.set_wiring(22, Wiring::PullUp));
+        assert_eq!(io.read_pin(22), Some(true), "external pull-up");
+        // An output reads what it drives.
+        assert!(io.set_pin_mode(22, PinMode::Output));
+        assert!(io.write_pin(22, false));
+        assert_eq!(io.read_pin(22), Some(false));
+        assert!(!io.set_wiring(25, Wiring::PullUp), "not a user pin");
     }
 }

@@ -46,6 +46,15 @@
 //!   rate; EEPROM registers are unlocked and locked around the write.
 //! * **Free mode** (0x1A 1): holding the Atom's button releases the joints so the arm can be
 //!   moved by hand; letting go holds it where it is.
+//! * **Drag teaching** (0xF1..0xF5): every joint's encoder and speed recorded 20 times a second
+//!   into 1 000 points, read back one point per request ([`drag`]).
+//! * **Move round** (0xD4) turns the accessory hobby servo (the Connect-4 kit's dispenser, on
+//!   the Grove port) one revolution; set four pieces zero (0xD7) stops it ([`dispenser`]).
+//! * **Circular arcs** (0x8B, 0x8C): along the circle through three poses, walked whole with
+//!   the inverse kinematics before the arm moves ([`motion`]).
+//! * **MyCobotBasic's layouts**: send coord's axis byte 0 is x (the seed manual's numbering; 1..6
+//!   stay pymycobot's x..rz); set / get PID (0x2C / 0x2D) write and read the joint servos' P, I,
+//!   D registers, six bytes for joints 1..3 and 4..6.
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 
@@ -55,8 +64,11 @@ mod bank;
 pub mod cartesian;
 mod commands;
 pub mod config;
+pub mod dispenser;
+pub mod drag;
 pub mod driver;
 pub mod error;
+mod gains;
 mod gripper;
 pub mod health;
 pub mod io;
@@ -71,4 +83,4 @@ pub use atom::Atom;
 pub use config::{AtomConfig, ConfigError, JointLimit, JointSign, TimingBudget};
 pub use error::AtomError;
 pub use health::ServoHealth;
-pub use io::{AtomIo, PinMode, RecordingIo};
+pub use io::{AtomIo, PinMode, RecordingIo, Wiring};

@@ -59,11 +59,15 @@ pub fn may_start_after_quiet(quiet_us: u64) -> bool {
 
 /// True if sending `request` to the Atom twice does no harm: everything but the incremental
 /// jogs (0x33 jog increment angle, 0x34 jog increment coord / jog stop), which would move the
-/// arm twice as far.
+/// arm twice as far, reading the next drag-teaching point (0xF3), which would skip one, and
+/// move round (0xD4), which would turn the dispenser twice.
 pub fn is_repeatable(request: &Frame) -> bool {
     !matches!(
         request.cmd(),
-        cmd::JOG_INCREMENT_ANGLE | cmd::JOG_INCREMENT_COORD
+        cmd::JOG_INCREMENT_ANGLE
+            | cmd::JOG_INCREMENT_COORD
+            | cmd::DRAG_GET_RECORD_DATA
+            | cmd::MOVE_ROUND
     )
 }
 
@@ -428,7 +432,7 @@ mod tests {
     }
 
     #[test]
-    fn only_incremental_jogs_are_never_repeated() {
+    fn only_requests_that_act_twice_are_never_repeated() {
         let frame = |cmd: u8, data: &[u8]| Frame::new(cmd, data).unwrap();
         assert!(!is_repeatable(&frame(
             cmd::JOG_INCREMENT_ANGLE,
@@ -438,6 +442,8 @@ mod tests {
             cmd::JOG_INCREMENT_COORD,
             &[1, 0, 100, 50]
         )));
+        assert!(!is_repeatable(&frame(cmd::DRAG_GET_RECORD_DATA, &[])));
+        assert!(!is_repeatable(&frame(cmd::MOVE_ROUND, &[])));
         assert!(is_repeatable(&frame(cmd::GET_ANGLES, &[])));
         assert!(is_repeatable(&frame(cmd::SEND_ANGLES, &[0; 13])));
     }

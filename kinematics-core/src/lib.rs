@@ -25,9 +25,10 @@
 //!   into the [`JointLimits`], the best fit (exact, then up to 0.2 mm clamped, then traded at the
 //!   wrist singularity) nearest the seed; or an [`IkError`] (protocol error 32). The zero pose,
 //!   the stretched elbow and the wrist singularity (J6 keeps the seed's angle) all solve.
-//! * [`Path`]s ([`Line`], [`Ray`], [`Turn`]) walked by [`PathWalker`], and [`LinearPath`] (a line
-//!   in equal steps): straight-line moves and Cartesian jogs, stopping with [`PathError`]
-//!   (33 / 34) instead of a joint jump or an unreachable step.
+//! * [`Path`]s ([`Line`], [`Ray`], [`Turn`], [`Arc`]) walked by [`PathWalker`] (and checked
+//!   whole by [`check_path`]), and [`LinearPath`] (a line in equal steps): straight-line and
+//!   circular moves and Cartesian jogs, stopping with [`PathError`] (33 / 34) instead of a joint
+//!   jump or an unreachable step.
 //! * [`Transform`]-level variants (`forward_transform`, `inverse_transform`) for callers that
 //!   chain small Cartesian steps and should not round to the wire's units in between.
 //!
@@ -63,7 +64,7 @@ pub mod transform;
 
 pub use geometry::ArmGeometry;
 pub use limits::JointLimits;
-pub use path::{Line, LinearPath, Path, PathError, PathWalker, Ray, Turn};
+pub use path::{Arc, Line, LinearPath, Path, PathError, PathWalker, Ray, Turn, check_path};
 pub use transform::{Rotation, Transform};
 
 use fixed::Angle;

@@ -1,5 +1,6 @@
 //! Cartesian paths: where the end goes (a [`Path`]: a straight [`Line`], a [`Ray`] along a base
-//! axis, a [`Turn`] about one, and later arcs) and how joint angles follow it ([`PathWalker`]).
+//! axis, a [`Turn`] about one, an [`Arc`] through three poses) and how joint angles follow it
+//! ([`PathWalker`], and [`check_path`] to walk a whole path coarsely before moving).
 //!
 //! A path is a pose for every point along it, measured in micrometres of travel, a degree of
 //! rotation counting as a millimetre ([`Path::length_um`]). The walker solves each point with the
@@ -8,6 +9,10 @@
 //! 1/64: the path slows there instead of flailing. A step that has no solution, or that still
 //! jumps at 1/64 (a branch switch, e.g. through the wrist singularity), stops the path instead of
 //! being executed. [`LinearPath`] is a line walked in equal steps.
+
+pub mod arc;
+
+pub use arc::Arc;
 
 use crate::fixed::{Angle, ratio};
 use crate::transform::{LEN_PER_TENTH_MM, Rotation, Transform};
@@ -42,13 +47,17 @@ pub enum PathError {
     },
     /// A step has no solution at all (out of reach or limits on the way).
     StepUnreachable(IkError),
+    /// The three points of an arc define no circle: two of them coincide, or they lie on one
+    /// line ([`Arc::through`]).
+    NoCircle,
 }
 
 impl PathError {
-    /// The 0x07 error code: 33 for a branch jump, 34 for an unreachable step.
+    /// The 0x07 error code: 33 when there is no continuous path (a branch jump, or an arc
+    /// through points that define no circle), 34 for an unreachable step.
     pub fn protocol_code(&self) -> u8 {
         match self {
-            Self::BranchJump { .. } => 33,
+            Self::BranchJump { .. } | Self::NoCircle => 33,
             Self::StepUnreachable(_) => 34,
         }
     }
@@ -304,6 +313,27 @@ impl<P: Path> PathWalker<P> {
     pub fn path(&self) -> &P {
         &self.path
     }
+}
+
+/// Walks all of `path` from the joint angles `start` in at most `checkpoints` equal steps, as
+/// a check before the arm moves: gives the joint angles at the end of the path, or the first
+/// [`PathError`] on the way (a point with no solution, or a step that still turns a joint by
+/// more than `jump_step_centideg` when split to 1/64). Coarse on purpose (one solution per
+/// checkpoint): a path that only grazes the workspace's edge between two checkpoints is still
+/// stopped by the walker that carries it out.
+pub fn check_path<P: Path>(
+    kin: &Kinematics,
+    path: P,
+    start: JointAngles,
+    checkpoints: u32,
+    jump_step_centideg: i32,
+) -> Result<JointAngles, PathError> {
+    let step_um = div_ceil(path.length_um(), i64::from(checkpoints.max(1))).max(1);
+    let mut walker = PathWalker::new(path, start);
+    while let Some(step) = walker.advance(kin, step_um, jump_step_centideg, jump_step_centideg) {
+        step?;
+    }
+    Ok(walker.current())
 }
 
 /// A straight line from a start configuration to a target pose in equal steps (split near

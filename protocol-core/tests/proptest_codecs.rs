@@ -131,6 +131,15 @@ fn request_strategies() -> Vec<BoxedStrategy<Request>> {
         (pose(), deg6())
             .prop_map(|(target, current)| R::SolveIk { target, current })
             .boxed(),
+        prop::array::uniform6(any::<u8>())
+            .prop_map(|gains| R::SetPid { gains })
+            .boxed(),
+        (pose(), pose(), pose())
+            .prop_map(|(begin, middle, end)| R::MoveCCoords { begin, middle, end })
+            .boxed(),
+        (pose(), pose())
+            .prop_map(|(middle, end)| R::MoveCCoordsFromHere { middle, end })
+            .boxed(),
         (joint(), direction(), speed())
             .prop_map(|(joint, direction, speed)| R::JogAngle {
                 joint,
@@ -364,6 +373,18 @@ fn reply() -> impl Strategy<Value = Reply> {
         }),
         (servo(), any::<bool>())
             .prop_map(|(servo, enabled)| Reply::ServoEnabled { servo, enabled }),
+        (
+            prop::array::uniform6(any::<i16>()),
+            prop::array::uniform6(any::<i16>())
+        )
+            .prop_map(|(e, v)| {
+                let point = DragPoint {
+                    encoders: e.map(Steps),
+                    speeds_steps_per_s: v,
+                };
+                // An all-zero point is how "no more points" is written.
+                Reply::DragPoint((point != DragPoint::default()).then_some(point))
+            }),
         prop::collection::vec(any::<u8>(), 0..=28)
             .prop_map(|v| Reply::Raw(heapless::Vec::from_slice(&v).unwrap())),
     ]

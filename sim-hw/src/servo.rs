@@ -11,8 +11,9 @@
 //! Positions: the shaft has a raw encoder position; registers report `raw - homing offset`
 //! (register 31), so writing 128 to torque enable (calibration) makes the present position 2048
 //! without moving anything. While torque is off the shaft stays where it is unless a test moves
-//! it by hand ([`SimServo::move_by_hand`]), and the goal follows the present position so
-//! re-enabling torque holds the arm still.
+//! it by hand ([`SimServo::move_by_hand`] at once, [`SimServo::move_by_hand_over`] smoothly over
+//! time, its speed reported as the present speed like the real encoder does), and the goal
+//! follows the present position so re-enabling torque holds the arm still.
 
 use std::collections::VecDeque;
 
@@ -102,6 +103,31 @@ impl Faults {
     };
 }
 
+/// A hand turning a released shaft: raw positions (steps) over time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct HandMove {
+    from: f64,
+    to: f64,
+    start_ns: u64,
+    duration_ns: u64,
+}
+
+impl HandMove {
+    /// Position (steps), speed (steps/s) and whether the move is over, at `now_ns`.
+    fn at(&self, now_ns: u64) -> (f64, f64, bool) {
+        let elapsed = now_ns.saturating_sub(self.start_ns);
+        if elapsed >= self.duration_ns {
+            return (self.to, 0.0, true);
+        }
+        let duration_s = self.duration_ns as f64 / 1e9;
+        let phase = std::f64::consts::PI * elapsed as f64 / self.duration_ns as f64;
+        let span = self.to - self.from;
+        let position = self.from + span * (1.0 - phase.cos()) / 2.0;
+        let velocity = span * std::f64::consts::PI / 2.0 * phase.sin() / duration_s;
+        (position, velocity, false)
+    }
+}
+
 /// Counters of what a servo did, for tests and benchmarks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ServoStats {
@@ -175,6 +201,8 @@ pub struct SimServo {
     faults: Faults,
     /// Answers still to send with a wrong checksum ([`SimServo::corrupt_next_answers`]).
     answers_to_corrupt: u32,
+    /// A hand turning the released shaft ([`SimServo::move_by_hand_over`]).
+    hand: Option<HandMove>,
     /// Writes still to miss ([`SimServo::lose_next_writes`]).
     writes_to_lose: u32,
     stats: ServoStats,
@@ -194,6 +222,7 @@ impl SimServo {
             registered: None,
             faults: Faults::NONE,
             answers_to_corrupt: 0,
+            hand: None,
             writes_to_lose: 0,
             stats: ServoStats::default(),
         };
@@ -352,6 +381,26 @@ impl SimServo {
         self.update_present_registers();
     }
 
+    /// Starts turning the shaft by hand, from where it is at `now_ns`, to present position
+    /// `position` (steps) in `duration_ns`, the way a hand does: speeding up and slowing down
+    /// smoothly (half a cosine), the speed peaking at pi/2 times the average. Only a released
+    /// shaft follows the hand; switching torque on ends the move where the shaft is.
+    pub fn move_by_hand_over(&mut self, position: u16, now_ns: u64, duration_ns: u64) {
+        self.advance(now_ns);
+        let to = f64::from(i32::from(position.min(4095)) + self.homing_offset());
+        self.hand = Some(HandMove {
+            from: self.raw_position_steps,
+            to,
+            start_ns: self.last_control_ns,
+            duration_ns: duration_ns.max(CONTROL_PERIOD_NS),
+        });
+    }
+
+    /// True while a hand turns the shaft ([`SimServo::move_by_hand_over`]).
+    pub fn hand_moving(&self) -> bool {
+        self.hand.is_some()
+    }
+
     /// The next instant this servo has something to do on the bus (a reply to start), in ns.
     pub fn next_event_ns(&self) -> Option<u64> {
         self.replies.front().map(|(t, _)| *t)
@@ -399,8 +448,17 @@ impl SimServo {
     fn control_step(&mut self, dt_s: f64) {
         let goal = f64::from(i32::from(self.goal_position()) + self.homing_offset());
         if !self.torque_enabled() {
-            // Free: the goal follows the shaft, so enabling torque holds it where it is.
+            // Free: the shaft goes where a hand takes it, and the goal follows the shaft, so
+            // enabling torque holds it where it is.
             self.velocity_steps_per_s = 0.0;
+            if let Some(hand) = self.hand {
+                let (position, velocity, done) = hand.at(self.last_control_ns);
+                self.raw_position_steps = position;
+                self.velocity_steps_per_s = velocity;
+                if done {
+                    self.hand = None;
+                }
+            }
             let present = self.present_position();
             self.set_u16(reg::GOAL_POSITION, present);
         } else if self.faults.stall {
@@ -656,6 +714,8 @@ impl SimServo {
                 self.set_u16(reg::GOAL_POSITION, present);
             }
             _ => {
+                // The servo holds the shaft: a hand turning it lets go.
+                self.hand = None;
                 if !self.torque_enabled() {
                     let present = self.present_position();
                     self.set_u16(reg::GOAL_POSITION, present);
@@ -977,6 +1037,45 @@ mod tests {
         rig.write(1, reg::TORQUE_ENABLE, &[1]);
         rig.run_for_ms(100);
         assert_eq!(rig.servo(0).present_position(), 1000);
+    }
+
+    #[test]
+    fn a_hand_turns_a_released_shaft_smoothly_and_its_speed_is_reported() {
+        let mut rig = Rig::new(&[1]);
+        let now = rig.now_ns;
+        rig.servo(0)
+            .move_by_hand_over(2048 + 400, now, 1_000_000_000);
+        rig.run_for_ms(500);
+        // Half way in time is half way in position, at the peak speed of pi/2 x 400 steps/s.
+        let position = rig
+            .read(1, reg::PRESENT_POSITION, 2)
+            .unwrap()
+            .u16_at(0)
+            .unwrap();
+        assert!((i32::from(position) - 2248).abs() <= 3, "{position}");
+        let speed = rig
+            .read(1, reg::PRESENT_SPEED, 2)
+            .unwrap()
+            .u16_at(0)
+            .unwrap();
+        assert!((f64::from(speed) - 628.0).abs() < 10.0, "{speed} steps/s");
+        assert!(rig.servo(0).hand_moving());
+        rig.run_for_ms(600);
+        assert!(!rig.servo(0).hand_moving());
+        assert_eq!(rig.servo(0).present_position(), 2448);
+        assert_eq!(
+            rig.read(1, reg::PRESENT_SPEED, 2).unwrap().u16_at(0),
+            Some(0)
+        );
+        // Torque on: the servo holds, the hand lets go.
+        let now = rig.now_ns;
+        rig.servo(0).move_by_hand_over(1000, now, 1_000_000_000);
+        rig.run_for_ms(100);
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        let held = rig.servo(0).present_position();
+        rig.run_for_ms(1_000);
+        assert!(!rig.servo(0).hand_moving());
+        assert!(rig.servo(0).present_position().abs_diff(held) <= 2);
     }
 
     #[test]

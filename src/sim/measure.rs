@@ -66,6 +66,50 @@ pub fn distance_to_segment_mm(p: &[f64; 3], a: &[f64; 3], b: &[f64; 3]) -> f64 {
     norm(&sub(p, &closest))
 }
 
+/// The circle through three points, for measuring arcs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Circle {
+    /// Centre, millimetres.
+    pub centre_mm: [f64; 3],
+    /// Radius, millimetres.
+    pub radius_mm: f64,
+    /// Unit normal of the circle's plane (turning about it takes `a` to `b` to `c`).
+    pub normal: [f64; 3],
+}
+
+impl Circle {
+    /// The circle through `a`, `b` and `c` (millimetres); `None` if they are collinear.
+    pub fn through(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Option<Self> {
+        let (u, v) = (sub(b, a), sub(c, a));
+        let w = cross(&u, &v);
+        let w2 = dot(&w, &w);
+        if w2 < 1e-12 {
+            return None;
+        }
+        let num = sub(&v.map(|x| x * dot(&u, &u)), &u.map(|x| x * dot(&v, &v)));
+        let off = cross(&num, &w);
+        let centre_mm = add(a, &off.map(|x| x / (2.0 * w2)));
+        Some(Self {
+            centre_mm,
+            radius_mm: norm(&sub(a, &centre_mm)),
+            normal: w.map(|x| x / w2.sqrt()),
+        })
+    }
+
+    /// Distance in millimetres from `p` to the circle.
+    pub fn distance_mm(&self, p: &[f64; 3]) -> f64 {
+        let v = sub(p, &self.centre_mm);
+        let out_of_plane = dot(&v, &self.normal);
+        let in_plane = sub(&v, &self.normal.map(|x| x * out_of_plane));
+        (out_of_plane.powi(2) + (norm(&in_plane) - self.radius_mm).powi(2)).sqrt()
+    }
+}
+
+/// Distance in millimetres between two points.
+pub fn distance_mm(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    norm(&sub(a, b))
+}
+
 /// Angle in degrees between two orientations.
 pub fn angle_between_deg(r1: &Rotation, r2: &Rotation) -> f64 {
     // trace(r1^T r2): the sum of the element-wise products.
@@ -102,6 +146,14 @@ fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     add(a, &b.map(|v| -v))
 }
 
+fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
 fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
@@ -131,6 +183,16 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn a_circle_through_three_points() {
+        let c = Circle::through(&[10.0, 0.0, 5.0], &[0.0, 10.0, 5.0], &[-10.0, 0.0, 5.0])
+            .expect("a circle");
+        assert!(distance_mm(&c.centre_mm, &[0.0, 0.0, 5.0]) < 1e-9);
+        assert!((c.radius_mm - 10.0).abs() < 1e-9);
+        assert!((c.distance_mm(&[0.0, -13.0, 9.0]) - 5.0).abs() < 1e-9);
+        assert!(Circle::through(&[0.0; 3], &[1.0, 1.0, 1.0], &[2.0, 2.0, 2.0]).is_none());
     }
 
     #[test]

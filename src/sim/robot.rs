@@ -675,6 +675,20 @@ impl VirtualRobot {
         self.servos.get_mut(id)
     }
 
+    /// A hand turns the released servo `id` from where it is now to present position
+    /// `position` (steps) over `duration_us`, speeding up and slowing down smoothly
+    /// ([`SimServo::move_by_hand_over`]); `false` if there is no such servo.
+    pub fn turn_by_hand(&mut self, id: u8, position: u16, duration_us: u64) -> bool {
+        let now = self.now_ns;
+        match self.servos.get_mut(id) {
+            Some(servo) => {
+                servo.move_by_hand_over(position, now, duration_us.saturating_mul(1_000));
+                true
+            }
+            None => false,
+        }
+    }
+
     /// Every simulated servo, in the order they were built (ids 1..7 at power-up).
     pub fn servos(&self) -> impl Iterator<Item = &SimServo> {
         self.servos.iter()

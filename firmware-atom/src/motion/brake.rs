@@ -57,9 +57,7 @@ impl Braking {
                 continue;
             }
             let v = i64::from(bank.velocity(j));
-            let travel_millisteps = v * (GOAL_LATENCY_US as i64 + brake_us / 2) / 1000;
-            let stop = (bank.estimated_millisteps(j) + travel_millisteps + 500).div_euclid(1000);
-            let stop = Steps(stop.clamp(0, i64::from(STEPS_PER_TURN) - 1) as i16);
+            let stop = rest_steps(bank, j, brake_us);
             let now = present.get(j).copied().unwrap_or_default();
             let mut angle = settings.angle(j, stop);
             if let Some(limit) = settings.limit(j) {
@@ -103,4 +101,33 @@ impl Braking {
             }
         }
     }
+}
+
+/// Where servo `index` comes to rest when it brakes for `brake_us`, decelerating evenly from
+/// its last read speed: its estimated present position, plus what it covers until the goal
+/// arrives ([`GOAL_LATENCY_US`]) and while braking (`v * brake / 2`).
+fn rest_steps(bank: &ServoBank, index: usize, brake_us: i64) -> Steps {
+    let v = i64::from(bank.velocity(index));
+    let travel_millisteps = v * (GOAL_LATENCY_US as i64 + brake_us / 2) / 1000;
+    let stop = (bank.estimated_millisteps(index) + travel_millisteps + 500).div_euclid(1000);
+    Steps(stop.clamp(0, i64::from(STEPS_PER_TURN) - 1) as i16)
+}
+
+/// The goal that stops servo `index` (the gripper, or one joint on its own) at the servos' full
+/// deceleration, where it comes to rest; `None` if it holds no torque.
+pub fn stop_one(bank: &ServoBank, settings: &Settings, index: usize) -> Option<Goal> {
+    if !bank.enabled(index) {
+        return None;
+    }
+    let config = settings.config();
+    let a = i64::from(config.motion.servo_accel_steps_per_s2.max(1));
+    let v = i64::from(bank.velocity(index));
+    let brake_us = v.abs() * 1_000_000 / a;
+    Some(Goal {
+        position: rest_steps(bank, index, brake_us),
+        speed_steps_per_s: v
+            .unsigned_abs()
+            .clamp(SETTLE_SPEED_STEPS_PER_S, u64::from(u16::MAX)) as u16,
+        accel: config.servo_accel_register(),
+    })
 }

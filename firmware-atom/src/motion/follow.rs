@@ -21,6 +21,12 @@ use crate::settings::Settings;
 /// (0.15 mm at the flange); the rest of a real difference is corrected at the next targets.
 const CORRECTION: (i64, i64) = (1, 4);
 
+/// Slowest goal speed towards the last target of a sequence, steps per second: the last
+/// target is where the joints stop, so each one heads there from where it really is, and a
+/// joint a step or two away gets there within a few hundredths of a second instead of crawling
+/// there at the speed its last step of the sequence happened to need.
+const FINAL_SPEED_MIN_STEPS_PER_S: i64 = 50;
+
 /// How the joints change speed between targets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Pace {
@@ -75,7 +81,7 @@ impl Follower {
         let from: [i64; JOINTS] = core::array::from_fn(|j| {
             let measured = bank.estimated_millisteps(j);
             match &self.last {
-                Some((expected, _)) => {
+                Some((expected, _)) if !last => {
                     let e = expected.get(j).copied().unwrap_or(measured);
                     e + (measured - e) * CORRECTION.0 / CORRECTION.1
                 }
@@ -93,6 +99,9 @@ impl Follower {
                 to.get(j).copied().unwrap_or(0),
             );
             match ((t - f) * 1000 / period).clamp(-cap, cap) {
+                v if last && t != f => {
+                    (t - f).signum() * v.abs().max(FINAL_SPEED_MIN_STEPS_PER_S.min(cap))
+                }
                 0 => (t - f).signum(),
                 v => v,
             }

@@ -2,8 +2,9 @@
 //!
 //! * **Joint moves** (send angles, encoders, joint jogs, increments) are planned so that every
 //!   joint arrives together ([`plan`]) and carried out by the servos' own ramps.
-//! * **Cartesian paths** (straight lines, Cartesian jogs) are walked by the firmware every
-//!   interpolation period ([`path`]) and followed by the joints ([`follow`]).
+//! * **Cartesian paths** (straight lines, circular arcs, Cartesian jogs) are walked by the
+//!   firmware every interpolation period ([`path`]) and followed by the joints ([`follow`]). An
+//!   arc is walked whole with the inverse kinematics before it is accepted.
 //! * **Streams**: in fresh mode, full targets that arrive within [`STREAM_GAP_MAX_US`] of each
 //!   other (a ROS node sending `send_angles` on every joint state) are followed without
 //!   stopping between them, each reached about one stream period after it arrived; a stream
@@ -31,7 +32,9 @@ use crate::config::JOINTS;
 use crate::error::AtomError;
 use crate::settings::Settings;
 use brake::Braking;
+pub use brake::stop_one;
 use follow::{Follower, Pace};
+pub use path::plan_arc;
 use path::{PathRunner, Step};
 pub use plan::{IN_POSITION_CENTIDEG, MOVE_OVERTIME_US, angles_match};
 pub use stream::STREAM_GAP_MAX_US;
@@ -54,15 +57,41 @@ pub enum JogDirection {
     Positive,
 }
 
-/// A move to joint angles (and, for a straight line, the pose it ends at).
+/// How the end travels to a target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Way {
+    /// Every joint on its own, all arriving together.
+    Joints,
+    /// Along a straight line to this pose (send coords mode 1).
+    Line(Pose),
+    /// Along the circle through the pose it starts from, `via` and `end` (0x8B, 0x8C).
+    Arc {
+        /// A pose the arc passes through.
+        via: Pose,
+        /// Where the arc ends.
+        end: Pose,
+    },
+}
+
+impl Way {
+    /// The pose a Cartesian path ends at.
+    pub fn end_pose(&self) -> Option<Pose> {
+        match self {
+            Self::Joints => None,
+            Self::Line(end) | Self::Arc { end, .. } => Some(*end),
+        }
+    }
+}
+
+/// A move to joint angles, and the way there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Target {
     /// Joint targets; `None` leaves a joint where it is going.
     pub angles: [Option<Centideg>; JOINTS],
     /// Speed, percent.
     pub speed_percent: u8,
-    /// `Some`: reach `angles` along a straight line to this pose (send coords mode 1).
-    pub line: Option<Pose>,
+    /// How the end gets there; for a Cartesian path `angles` solve its end pose.
+    pub way: Way,
 }
 
 impl Target {
@@ -71,10 +100,14 @@ impl Target {
         Self {
             angles,
             speed_percent,
-            line: None,
+            way: Way::Joints,
         }
     }
 }
+
+/// Distance within which the arm counts as already at the start of an arc (0x8B), so no line
+/// leads to it: 0.5 mm (5 wire units) and 0.5 deg (50).
+const AT_ARC_START: (i32, i32) = (5, 50);
 
 /// A continuous jog.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -113,12 +146,13 @@ enum Activity {
         duration_us: u64,
         jog: Option<Jog>,
     },
-    /// A Cartesian path; `target` is where it ends (a line) or has got to (a jog).
+    /// A Cartesian path; `target` is where it ends (a line, an arc: `way`) or has got to (a
+    /// jog: `way` is `None`).
     Path {
         runner: PathRunner,
         follower: Follower,
         target: [Centideg; JOINTS],
-        line: Option<Pose>,
+        way: Option<Way>,
         speed_percent: u8,
         jog: Option<Jog>,
     },
@@ -303,14 +337,15 @@ impl MotionController {
                 ..
             } => Some(Target::joints(target.map(Some), speed_percent)),
             Activity::Path {
+                runner,
                 target,
-                line: Some(pose),
+                way: Some(way),
                 speed_percent,
                 ..
             } => Some(Target {
                 angles: target.map(Some),
                 speed_percent,
-                line: Some(pose),
+                way: rest_of(way, &runner),
             }),
             Activity::Braking {
                 then: Some(Order::Move(t)),
@@ -384,16 +419,97 @@ impl MotionController {
         }
     }
 
-    /// The pose a straight line is going to, if one runs.
+    /// The pose a straight line or an arc is going to, if one runs.
     pub fn planned_pose(&self) -> Option<Pose> {
         match &self.activity {
-            Activity::Path { line, .. } => *line,
+            Activity::Path { way, .. } => way.and_then(|w| w.end_pose()),
             Activity::Braking {
                 then: Some(Order::Move(t)),
                 ..
-            } => t.line,
+            } => t.way.end_pose(),
             _ => None,
         }
+    }
+
+    /// Accepts a circular arc (0x8B, 0x8C) through `via` to `end` at `speed_percent`: from
+    /// `begin`, reached first along a straight line (unless the arm is there already), or from
+    /// where the arm is. The whole arc is walked with the inverse kinematics before anything
+    /// moves ([`plan_arc`]); in fresh mode it replaces the current motion, in queue mode its
+    /// parts wait their turn.
+    #[allow(clippy::too_many_arguments)]
+    pub fn submit_arc(
+        &mut self,
+        now_us: u64,
+        begin: Option<Pose>,
+        via: Pose,
+        end: Pose,
+        speed_percent: u8,
+        bank: &mut ServoBank,
+        settings: &Settings,
+    ) -> Result<(), AtomError> {
+        if !bank.powered() {
+            return Err(AtomError::PoweredOff);
+        }
+        // Where the arc starts from: where the arm comes to rest (fresh mode), or where the
+        // moves before it end (queue mode).
+        let mut from = if settings.fresh_mode() {
+            bank.present_angles(settings)
+        } else {
+            self.queue
+                .back()
+                .and_then(|t| full_angles(&t.angles))
+                .unwrap_or_else(|| self.planned_angles(bank, settings))
+        };
+        let mut parts: heapless::Vec<Target, 2> = heapless::Vec::new();
+        if let Some(begin) = begin {
+            let cart = settings.cart();
+            let here =
+                crate::cartesian::from_kin(&cart.model().forward(&crate::cartesian::joints(&from)));
+            if !poses_within(&here, &begin, AT_ARC_START) {
+                let angles = cart.inverse(&begin, &from)?;
+                let line = Target {
+                    angles: angles.map(Some),
+                    speed_percent,
+                    way: Way::Line(begin),
+                };
+                check(bank, settings, &line)?;
+                parts.push(line).map_err(|_| AtomError::Busy)?;
+                from = angles;
+            }
+        }
+        let (_, angles) = plan_arc(settings, &from, &via, &end)?;
+        let arc = Target {
+            angles: angles.map(Some),
+            speed_percent,
+            way: Way::Arc { via, end },
+        };
+        check(bank, settings, &arc)?;
+        parts.push(arc).map_err(|_| AtomError::Busy)?;
+        let mut parts = parts.into_iter();
+        let Some(first) = parts.next() else {
+            return Ok(());
+        };
+        if settings.fresh_mode() {
+            self.forget_plans();
+            self.replace(now_us, Order::Move(first), bank, settings)?;
+            for t in parts {
+                self.queue.push_back(t).map_err(|_| AtomError::Busy)?;
+            }
+            return Ok(());
+        }
+        if MOTION_QUEUE - self.queue.len() < 1 + parts.len() {
+            return Err(AtomError::Busy);
+        }
+        if matches!(self.activity, Activity::Idle) && self.queue.is_empty() && self.paused.is_none()
+        {
+            self.start(now_us, Order::Move(first), bank, settings)?;
+        } else {
+            self.queue.push_back(first).map_err(|_| AtomError::Busy)?;
+        }
+        for t in parts {
+            self.queue.push_back(t).map_err(|_| AtomError::Busy)?;
+        }
+        Ok(())
     }
 
     /// Runs what is due at `now_us`: the jog watchdog, the next point of a path, the end of a
@@ -579,9 +695,9 @@ impl MotionController {
         settings: &Settings,
     ) -> Result<(), AtomError> {
         match order {
-            Order::Move(target) => match target.line {
-                Some(pose) => self.start_line(now_us, target, pose, bank, settings),
-                None => self.start_joint_move(now_us, target, None, bank, settings),
+            Order::Move(target) => match target.way {
+                Way::Line(_) | Way::Arc { .. } => self.start_path(now_us, target, bank, settings),
+                Way::Joints => self.start_joint_move(now_us, target, None, bank, settings),
             },
             Order::Jog {
                 jog: jog @ Jog::Joint { joint, direction },
@@ -610,7 +726,7 @@ impl MotionController {
                     runner,
                     follower: Follower::default(),
                     target: present,
-                    line: None,
+                    way: None,
                     speed_percent,
                     jog: Some(jog),
                 };
@@ -665,19 +781,25 @@ impl MotionController {
         Ok(())
     }
 
-    /// Starts the straight line from the present position to `pose` (whose joint angles are
-    /// `target.angles`).
-    fn start_line(
+    /// Starts the Cartesian path of `target` (a straight line or an arc) from the present
+    /// position; `target.angles` solve its end.
+    fn start_path(
         &mut self,
         now_us: u64,
         target: Target,
-        pose: Pose,
         bank: &mut ServoBank,
         settings: &Settings,
     ) -> Result<(), AtomError> {
         check(bank, settings, &target)?;
         let present = bank.present_angles(settings);
-        let runner = PathRunner::line(settings, now_us, &present, &pose, target.speed_percent)?;
+        let speed = target.speed_percent;
+        let runner = match target.way {
+            Way::Line(pose) => PathRunner::line(settings, now_us, &present, &pose, speed)?,
+            Way::Arc { via, end } => {
+                PathRunner::arc(settings, now_us, &present, &via, &end, speed)?
+            }
+            Way::Joints => return Err(AtomError::Invalid),
+        };
         self.activity = Activity::Path {
             runner,
             follower: Follower::default(),
@@ -685,7 +807,7 @@ impl MotionController {
                 let here = present.get(j).copied().unwrap_or_default();
                 target.angles.get(j).copied().flatten().unwrap_or(here)
             }),
-            line: Some(pose),
+            way: Some(target.way),
             speed_percent: target.speed_percent,
             jog: None,
         };
@@ -735,6 +857,37 @@ fn arriving(
         duration_us: period_us,
         jog: None,
     }
+}
+
+/// What is left of a Cartesian path interrupted by a pause: the rest of a line is the same
+/// line; the rest of an arc is an arc through a pose ahead on the same circle (a straight line
+/// when less than 2 mm are left).
+fn rest_of(way: Way, runner: &PathRunner) -> Way {
+    match way {
+        Way::Arc { end, .. } if runner.remaining_um() >= 2_000 => Way::Arc {
+            via: runner.halfway_ahead(),
+            end,
+        },
+        Way::Arc { end, .. } => Way::Line(end),
+        other => other,
+    }
+}
+
+/// True if two poses are within `(position, orientation)` wire units of each other (0.1 mm,
+/// 0.01 deg; angles wrap at 360 deg).
+fn poses_within(a: &Pose, b: &Pose, (position, orientation): (i32, i32)) -> bool {
+    a.to_array()
+        .iter()
+        .zip(&b.to_array())
+        .enumerate()
+        .all(|(i, (x, y))| {
+            let d = (i32::from(*x) - i32::from(*y)).abs();
+            if i < 3 {
+                d <= position
+            } else {
+                d.min(36_000 - d) <= orientation
+            }
+        })
 }
 
 /// Checks a target against power and limits without moving.

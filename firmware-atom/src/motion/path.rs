@@ -1,5 +1,5 @@
-//! Cartesian paths walked by the firmware: straight lines (send coords mode 1) and Cartesian
-//! jogs (0x31, 0x32), and any later path (arcs) alike.
+//! Cartesian paths walked by the firmware: straight lines (send coords mode 1), circular arcs
+//! (0x8B, 0x8C) and Cartesian jogs (0x31, 0x32) alike.
 //!
 //! Every interpolation period the runner moves along its [`Path`] at a speed that ramps up from
 //! rest, cruises and (for a path with an end) ramps down to arrive at rest, solves the joint
@@ -7,7 +7,8 @@
 //! them one period later. Where joints would have to move faster than the speed allows (next to
 //! a singularity), the walker takes a shorter step and the path slows there.
 
-use kinematics_core::{Kinematics, Line, Path, PathWalker, Ray, Transform, Turn};
+use kinematics_core::{Arc, Kinematics, Line, Path, PathError, PathWalker, Ray, Transform, Turn};
+use protocol_core::command::Pose;
 use protocol_core::units::Centideg;
 
 use crate::cartesian;
@@ -24,7 +25,18 @@ const UM_PER_CENTIDEG: i64 = 10;
 /// jump (error 33), however slowly the path goes: 5 deg in one interpolation period.
 const JUMP_STEP_CENTIDEG: i32 = kinematics_core::path::DEFAULT_MAX_JOINT_STEP_CENTIDEG;
 
+/// Points at which an arc is solved before it starts ([`plan_arc`]): 32, a few milliseconds
+/// of inverse kinematics on the Atom, one every 6 mm of a 200 mm arc.
+const ARC_CHECKPOINTS: u32 = 32;
+
+/// Largest joint turn between two checkpoints of an arc that is not a branch flip: 45 deg (a
+/// flip turns a joint by about 180 deg; 1/32 of an arc turns none by more than a few degrees
+/// away from singularities, and a step is split up to 64 times near them).
+const ARC_CHECK_JUMP_CENTIDEG: i32 = 4_500;
+
 /// The paths the Atom walks.
+// One path is walked at a time, held in place (no allocator): the arc's size costs nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug)]
 pub enum AnyPath {
     /// A straight line to a pose.
@@ -33,6 +45,8 @@ pub enum AnyPath {
     Ray(Ray),
     /// A rotation jog about a base axis.
     Turn(Turn),
+    /// A circular arc through three poses.
+    Arc(Arc),
 }
 
 impl Path for AnyPath {
@@ -41,6 +55,7 @@ impl Path for AnyPath {
             Self::Line(p) => p.length_um(),
             Self::Ray(p) => p.length_um(),
             Self::Turn(p) => p.length_um(),
+            Self::Arc(p) => p.length_um(),
         }
     }
 
@@ -49,6 +64,7 @@ impl Path for AnyPath {
             Self::Line(p) => p.pose_at(at_um),
             Self::Ray(p) => p.pose_at(at_um),
             Self::Turn(p) => p.pose_at(at_um),
+            Self::Arc(p) => p.pose_at(at_um),
         }
     }
 }
@@ -99,6 +115,28 @@ impl PathRunner {
             settings,
             now_us,
             AnyPath::Line(line),
+            from,
+            cruise,
+            speed_percent,
+        ))
+    }
+
+    /// A circular arc from the joint angles `from` through `via` to `end` at `speed_percent`,
+    /// checked whole first ([`plan_arc`]).
+    pub fn arc(
+        settings: &Settings,
+        now_us: u64,
+        from: &[Centideg; JOINTS],
+        via: &Pose,
+        end: &Pose,
+        speed_percent: u8,
+    ) -> Result<Self, AtomError> {
+        let (arc, _) = plan_arc(settings, from, via, end)?;
+        let cruise = linear_speed_um_per_s(settings, speed_percent);
+        Ok(Self::new(
+            settings,
+            now_us,
+            AnyPath::Arc(arc),
             from,
             cruise,
             speed_percent,
@@ -212,6 +250,50 @@ impl PathRunner {
     pub fn joint_speed_cap(&self) -> u32 {
         self.joint_speed_cap
     }
+
+    /// A pose on the part of the path not walked yet, halfway along it: where an arc that was
+    /// interrupted still has to pass to stay on its circle.
+    pub fn halfway_ahead(&self) -> Pose {
+        let path = self.walker.path();
+        let at = self.walker.done_um() + self.walker.remaining_um() / 2;
+        cartesian::from_kin(&path.pose_at(at).to_pose())
+    }
+
+    /// What is left of the path, micrometres.
+    pub fn remaining_um(&self) -> i64 {
+        self.walker.remaining_um()
+    }
+}
+
+/// The arc from the joint angles `from` through `via` to `end`, and the joint angles it ends
+/// at, checked whole before anything moves: `via` and `end` must solve (error 32), the three
+/// poses must define a circle (33), and the arc is walked with the inverse kinematics at
+/// [`ARC_CHECKPOINTS`] points (34 where it leaves the workspace or the joint limits, 33 where
+/// the arm would have to flip branch).
+pub fn plan_arc(
+    settings: &Settings,
+    from: &[Centideg; JOINTS],
+    via: &Pose,
+    end: &Pose,
+) -> Result<(Arc, [Centideg; JOINTS]), AtomError> {
+    let model = settings.cart().model();
+    let start = cartesian::joints(from);
+    let (via, end) = (
+        Transform::from_pose(&cartesian::to_kin(via)),
+        Transform::from_pose(&cartesian::to_kin(end)),
+    );
+    model.inverse_transform(&via, &start)?;
+    model.inverse_transform(&end, &start)?;
+    let arc = Arc::through(model.forward_transform(&start), via, end)
+        .ok_or(AtomError::Path(PathError::NoCircle))?;
+    let q = kinematics_core::check_path(
+        model,
+        AnyPath::Arc(arc),
+        start,
+        ARC_CHECKPOINTS,
+        ARC_CHECK_JUMP_CENTIDEG,
+    )?;
+    Ok((arc, cartesian::angles(&q)))
 }
 
 /// Cartesian speed at `speed_percent`, micrometres per second.

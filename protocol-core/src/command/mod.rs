@@ -39,8 +39,8 @@ mod types;
 mod wire;
 
 pub use error::{CommandError, ErrorCode, ServoErrorCode};
-pub use reply::{Reply, ReplyError, ReplyKind};
-pub use request::Request;
+pub use reply::{DragPoint, Reply, ReplyError, ReplyKind};
+pub use request::{MAX_DRAG_SPEED, Request};
 pub use types::{
     AtomPin, Axis, AxisValue, BasicInputPin, BasicOutputPin, DataWidth, Direction, EndType,
     GripperModel, GripperSpeed, GripperState, GripperType, GripperValue, JointId, MoveMode,
@@ -109,6 +109,11 @@ pub mod cmd {
     pub const IS_IN_POSITION: u8 = 0x2A;
     /// Is moving: 1 byte.
     pub const IS_MOVING: u8 = 0x2B;
+    /// Set the position-loop gains (MyCobotBasic `setPid`, `SET_PID`): six bytes, P, I, D of
+    /// joints 1..3 then of joints 4..6.
+    pub const SET_PID: u8 = 0x2C;
+    /// Get the position-loop gains (MyCobotBasic `getPid`, `GET_PID`): six bytes as 0x2C.
+    pub const GET_PID: u8 = 0x2D;
     /// Jog one joint.
     pub const JOG_ANGLE: u8 = 0x30;
     /// Jog rotation about a base axis (`JOG_ABSOLUTE` in pymycobot).
@@ -209,6 +214,12 @@ pub mod cmd {
     pub const SET_END_TYPE: u8 = 0x89;
     /// Get end type: 1 byte.
     pub const GET_END_TYPE: u8 = 0x8A;
+    /// Circular arc through three poses: begin, middle, end (MyCobotBasic `moveCCoords` with
+    /// three poses, `MOVEC_COORDS_DEFAULT`).
+    pub const MOVE_C_COORDS: u8 = 0x8B;
+    /// Circular arc from the present pose through middle to end (MyCobotBasic `moveCCoords`
+    /// with two poses, `MOVEC_COORDS`).
+    pub const MOVE_C_COORDS_FROM_HERE: u8 = 0x8C;
     /// Solve inverse kinematics: 6 x int16 angles.
     pub const SOLVE_INV_KINEMATICS: u8 = 0x8D;
     /// Set a Basic output (answered by the Basic).
@@ -229,11 +240,13 @@ pub mod cmd {
     pub const SET_TRANSPONDER_MODE: u8 = 0xC2;
     /// Get transponder mode: 1 byte (answered by the Basic; `GET_COMMUNICATE_MODE`).
     pub const GET_TRANSPONDER_MODE: u8 = 0xC3;
-    /// Move round (pymycobot `move_round`, no data).
+    /// Move round (pymycobot `move_round`, `SET_GSERVO_ROUND`): one turn of the 9 g hobby
+    /// servo of the Connect-4 kit's piece dispenser (no data).
     pub const MOVE_ROUND: u8 = 0xD4;
     /// Get angles and coords: 12 x int16.
     pub const GET_ANGLES_COORDS: u8 = 0xD5;
-    /// Set four pieces zero (pymycobot `set_four_pieces_zero`): 1 byte.
+    /// Set four pieces zero (pymycobot `set_four_pieces_zero`): the Connect-4 ("four pieces")
+    /// dispenser servo back to its rest position; 1 byte.
     pub const SET_FOUR_PIECES_ZERO: u8 = 0xD7;
     /// Get reboot count: int16.
     pub const GET_REBOOT_COUNT: u8 = 0xD8;
@@ -251,15 +264,15 @@ pub mod cmd {
     pub const BACKUP_SERVO_PARAMS: u8 = 0xEA;
     /// Restore servo parameters; 254 = all (`RESUME_SERVO_PARAMS`).
     pub const RESTORE_SERVO_PARAMS: u8 = 0xEB;
-    /// Drag teaching: start recording.
+    /// Drag teaching: start recording; int16 points recorded.
     pub const DRAG_START_RECORD: u8 = 0xF1;
-    /// Drag teaching: end recording.
+    /// Drag teaching: end recording; int16 points recorded.
     pub const DRAG_END_RECORD: u8 = 0xF2;
-    /// Drag teaching: get recorded data.
+    /// Drag teaching: the next recorded point ([`DragPoint`](super::DragPoint)), one per call.
     pub const DRAG_GET_RECORD_DATA: u8 = 0xF3;
-    /// Drag teaching: get record length.
+    /// Drag teaching: int16 points recorded.
     pub const DRAG_GET_RECORD_LEN: u8 = 0xF4;
-    /// Drag teaching: clear recorded data.
+    /// Drag teaching: forget the recorded points; int16 0.
     pub const DRAG_CLEAR_RECORD_DATA: u8 = 0xF5;
     /// Get planned angles (target being executed): 6 x int16 (`GET_ANGLES_PLAN`).
     pub const GET_PLANNED_ANGLES: u8 = 0xF6;
@@ -267,15 +280,15 @@ pub mod cmd {
     pub const GET_PLANNED_COORDS: u8 = 0xF7;
 
     /// Every command code this crate models, ascending.
-    pub const ALL: [u8; 106] = [
+    pub const ALL: [u8; 110] = [
         0x01, 0x02, 0x05, 0x06, 0x07, 0x08, 0x10, 0x11, 0x12, 0x13, 0x14, 0x15, 0x16, 0x17, 0x1A,
-        0x1B, 0x1D, 0x20, 0x21, 0x22, 0x23, 0x24, 0x25, 0x26, 0x27, 0x28, 0x29, 0x2A, 0x2B, 0x30,
-        0x31, 0x32, 0x33, 0x34, 0x35, 0x36, 0x37, 0x38, 0x39, 0x3A, 0x3B, 0x3C, 0x3D, 0x3E, 0x40,
-        0x41, 0x4A, 0x4B, 0x4C, 0x4D, 0x50, 0x51, 0x52, 0x53, 0x54, 0x55, 0x56, 0x57, 0x60, 0x61,
-        0x62, 0x64, 0x65, 0x66, 0x67, 0x68, 0x69, 0x6A, 0x81, 0x82, 0x83, 0x84, 0x85, 0x86, 0x87,
-        0x88, 0x89, 0x8A, 0x8D, 0xA0, 0xA1, 0xB0, 0xB1, 0xB2, 0xC0, 0xC1, 0xC2, 0xC3, 0xD4, 0xD5,
-        0xD7, 0xD8, 0xE1, 0xE2, 0xE3, 0xE4, 0xE5, 0xEA, 0xEB, 0xF1, 0xF2, 0xF3, 0xF4, 0xF5, 0xF6,
-        0xF7,
+        0x1B, 0x1D, 0x20, 0x21, 0x22, 0x23, 0x24, 0x25, 0x26, 0x27, 0x28, 0x29, 0x2A, 0x2B, 0x2C,
+        0x2D, 0x30, 0x31, 0x32, 0x33, 0x34, 0x35, 0x36, 0x37, 0x38, 0x39, 0x3A, 0x3B, 0x3C, 0x3D,
+        0x3E, 0x40, 0x41, 0x4A, 0x4B, 0x4C, 0x4D, 0x50, 0x51, 0x52, 0x53, 0x54, 0x55, 0x56, 0x57,
+        0x60, 0x61, 0x62, 0x64, 0x65, 0x66, 0x67, 0x68, 0x69, 0x6A, 0x81, 0x82, 0x83, 0x84, 0x85,
+        0x86, 0x87, 0x88, 0x89, 0x8A, 0x8B, 0x8C, 0x8D, 0xA0, 0xA1, 0xB0, 0xB1, 0xB2, 0xC0, 0xC1,
+        0xC2, 0xC3, 0xD4, 0xD5, 0xD7, 0xD8, 0xE1, 0xE2, 0xE3, 0xE4, 0xE5, 0xEA, 0xEB, 0xF1, 0xF2,
+        0xF3, 0xF4, 0xF5, 0xF6, 0xF7,
     ];
 
     /// True if `code` is a command this crate models.

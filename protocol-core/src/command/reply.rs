@@ -58,8 +58,21 @@ pub enum Reply {
         /// Torque on.
         enabled: bool,
     },
+    /// One recorded drag-teaching point (0xF3), or `None` once every point was read: 24 bytes,
+    /// joint by joint the encoder then the speed (int16 each), all zero for `None` (pymycobot
+    /// splits even and odd values into `[[encoders], [speeds]]`, and answers -1 for all zero).
+    DragPoint(Option<DragPoint>),
     /// Anything else, raw.
     Raw(Vec<u8, MAX_REPLY_DATA>),
+}
+
+/// One point of a drag-teaching recording: where each joint was and how fast it turned.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct DragPoint {
+    /// Encoder position of joints 1..6, steps (0..=4095).
+    pub encoders: [Steps; 6],
+    /// Speed of joints 1..6, steps per second (what set encoders drag, 0x3E, takes back).
+    pub speeds_steps_per_s: [i16; 6],
 }
 
 /// The shape of reply a request expects ([`Request::reply_kind`](super::Request::reply_kind)).
@@ -91,6 +104,8 @@ pub enum ReplyKind {
     JointLimit,
     /// [`Reply::ServoEnabled`].
     ServoEnabled,
+    /// [`Reply::DragPoint`].
+    DragPoint,
     /// [`Reply::Raw`].
     Raw,
 }
@@ -126,6 +141,7 @@ impl Reply {
             Self::PinLevel { .. } => ReplyKind::PinLevel,
             Self::JointLimit { .. } => ReplyKind::JointLimit,
             Self::ServoEnabled { .. } => ReplyKind::ServoEnabled,
+            Self::DragPoint(_) => ReplyKind::DragPoint,
             Self::Raw(_) => ReplyKind::Raw,
         }
     }
@@ -173,6 +189,12 @@ impl Reply {
             Self::ServoEnabled { servo, enabled } => {
                 w.u8(servo.get()).u8(u8::from(*enabled));
             }
+            Self::DragPoint(point) => {
+                let point = point.unwrap_or_default();
+                for (e, v) in point.encoders.iter().zip(point.speeds_steps_per_s) {
+                    w.i16(e.0).i16(v);
+                }
+            }
             Self::Raw(data) => {
                 w.bytes(data);
             }
@@ -195,7 +217,7 @@ impl Reply {
             ReplyKind::Bytes6 => 6,
             ReplyKind::ServoErrors => 7,
             ReplyKind::Angles | ReplyKind::Coords | ReplyKind::Encoders | ReplyKind::Int16x6 => 12,
-            ReplyKind::AnglesAndCoords => 24,
+            ReplyKind::AnglesAndCoords | ReplyKind::DragPoint => 24,
             ReplyKind::Raw => data.len(),
         };
         if data.len() != expected || data.len() > MAX_REPLY_DATA {
@@ -241,6 +263,18 @@ impl Reply {
                     servo: ServoId::new(s).ok_or(ReplyError::BadValue(s))?,
                     enabled: flag(r.u8().ok_or(bad_len)?)?,
                 }
+            }
+            ReplyKind::DragPoint => {
+                let mut point = DragPoint::default();
+                for (e, v) in point
+                    .encoders
+                    .iter_mut()
+                    .zip(point.speeds_steps_per_s.iter_mut())
+                {
+                    *e = Steps(r.i16().ok_or(bad_len)?);
+                    *v = r.i16().ok_or(bad_len)?;
+                }
+                Self::DragPoint((point != DragPoint::default()).then_some(point))
             }
             ReplyKind::Raw => Self::Raw(Vec::from_slice(data).map_err(|_| bad_len)?),
         };

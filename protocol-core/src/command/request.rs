@@ -144,6 +144,32 @@ pub enum Request {
     },
     /// 0x2B is moving.
     IsMoving,
+    /// 0x2C (LEN 8, MyCobotBasic `setPid`) set the servos' position-loop gains: P, I, D of
+    /// joints 1..3, then P, I, D of joints 4..6, one byte each.
+    SetPid {
+        /// P, I, D of joints 1..3, then of joints 4..6.
+        gains: [u8; 6],
+    },
+    /// 0x2D (MyCobotBasic `getPid`) get the gains as 0x2C sets them.
+    GetPid,
+    /// 0x8B (LEN 38, MyCobotBasic `moveCCoords(begin, middle, end)`) go to `begin`, then along
+    /// the circle through `begin`, `middle` and `end` to `end`, at the default speed (0x41).
+    MoveCCoords {
+        /// Where the arc starts.
+        begin: Pose,
+        /// A pose the arc passes through.
+        middle: Pose,
+        /// Where the arc ends.
+        end: Pose,
+    },
+    /// 0x8C (LEN 26, MyCobotBasic `moveCCoords(middle, end)`) along the circle through the
+    /// present pose, `middle` and `end` to `end`, at the default speed (0x41).
+    MoveCCoordsFromHere {
+        /// A pose the arc passes through.
+        middle: Pose,
+        /// Where the arc ends.
+        end: Pose,
+    },
     /// 0x8D solve inverse kinematics.
     SolveIk {
         /// Pose to reach.
@@ -592,6 +618,7 @@ no_data_commands! {
     DragGetRecordData = cmd::DRAG_GET_RECORD_DATA,
     DragGetRecordLen = cmd::DRAG_GET_RECORD_LEN,
     DragClearRecordData = cmd::DRAG_CLEAR_RECORD_DATA,
+    GetPid = cmd::GET_PID,
 }
 
 /// Reads a frame's fields, turning each raw byte into its validated type.
@@ -785,7 +812,11 @@ impl Request {
                 angles: f.centideg6()?,
             },
             (cmd::SEND_COORD, 4) => Self::SendCoord {
-                target: f.axis_value()?,
+                target: {
+                    let v = f.u8()?;
+                    let axis = Axis::from_send_coord_byte(v).ok_or(CommandError::BadAxis(v))?;
+                    AxisValue::new(axis, f.i16()?)
+                },
                 speed: f.speed()?,
             },
             (cmd::SEND_COORDS, 13 | 14) => Self::SendCoords {
@@ -806,6 +837,18 @@ impl Request {
                     },
                 }
             }
+            (cmd::SET_PID, 6) => Self::SetPid {
+                gains: [f.u8()?, f.u8()?, f.u8()?, f.u8()?, f.u8()?, f.u8()?],
+            },
+            (cmd::MOVE_C_COORDS, 36) => Self::MoveCCoords {
+                begin: f.pose()?,
+                middle: f.pose()?,
+                end: f.pose()?,
+            },
+            (cmd::MOVE_C_COORDS_FROM_HERE, 24) => Self::MoveCCoordsFromHere {
+                middle: f.pose()?,
+                end: f.pose()?,
+            },
             (cmd::SOLVE_INV_KINEMATICS, 24) => Self::SolveIk {
                 target: f.pose()?,
                 current: f.centideg6()?,
@@ -1073,7 +1116,11 @@ impl Request {
             | Self::GetTofDistance
             | Self::GetHtsGripperTorque
             | Self::GetGripperProtectCurrent
-            | Self::DragGetRecordLen => K::Int16,
+            | Self::DragStartRecord
+            | Self::DragEndRecord
+            | Self::DragGetRecordLen
+            | Self::DragClearRecordData => K::Int16,
+            Self::DragGetRecordData => K::DragPoint,
             Self::GetAngles | Self::GetPlannedAngles | Self::SolveIk { .. } => K::Angles,
             Self::GetCoords
             | Self::AnglesToCoords { .. }
@@ -1082,13 +1129,15 @@ impl Request {
             | Self::GetWorldReference => K::Coords,
             Self::GetEncoders => K::Encoders,
             Self::GetServoSpeeds | Self::GetServoCurrents => K::Int16x6,
-            Self::GetServoVoltages | Self::GetServoStatus | Self::GetServoTemps => K::Bytes6,
+            Self::GetServoVoltages | Self::GetServoStatus | Self::GetServoTemps | Self::GetPid => {
+                K::Bytes6
+            }
             Self::ReadNextError => K::ServoErrors,
             Self::GetAnglesCoords => K::AnglesAndCoords,
             Self::GetDigitalInput { .. } | Self::GetBasicInput { .. } => K::PinLevel,
             Self::GetJointMin { .. } | Self::GetJointMax { .. } => K::JointLimit,
             Self::IsServoEnabled { .. } => K::ServoEnabled,
-            Self::GetSsidPwd | Self::DragGetRecordData => K::Raw,
+            Self::GetSsidPwd => K::Raw,
             _ => K::Ack,
         }
     }
@@ -1155,6 +1204,18 @@ impl Request {
             Self::SolveIk { target, current } => {
                 w.pose(target).centideg6(current);
                 cmd::SOLVE_INV_KINEMATICS
+            }
+            Self::SetPid { gains } => {
+                w.bytes(gains);
+                cmd::SET_PID
+            }
+            Self::MoveCCoords { begin, middle, end } => {
+                w.pose(begin).pose(middle).pose(end);
+                cmd::MOVE_C_COORDS
+            }
+            Self::MoveCCoordsFromHere { middle, end } => {
+                w.pose(middle).pose(end);
+                cmd::MOVE_C_COORDS_FROM_HERE
             }
             Self::JogAngle {
                 joint,
@@ -1549,6 +1610,100 @@ mod tests {
             parse(cmd::SET_GRIPPER_STATE, &[1]),
             Ok(Request::SetGripperStateNoSpeed { .. })
         ));
+    }
+
+    #[test]
+    fn send_coord_takes_both_axis_numberings_where_they_are_unambiguous() {
+        use crate::units::{Centideg as C, DeciMm as M};
+        let coord = |data: &[u8]| match parse(cmd::SEND_COORD, data) {
+            Ok(Request::SendCoord { target, .. }) => Ok(target),
+            other => Err(other),
+        };
+        // MyCobotBasic writeCoord(Axis::X, 200, 30): axis 0 (seed manual numbering).
+        assert_eq!(coord(&[0, 0x07, 0xD0, 30]), Ok(AxisValue::X(M(2000))));
+        // pymycobot send_coord(1, 200, 30) and send_coord(6, -90, 30).
+        assert_eq!(coord(&[1, 0x07, 0xD0, 30]), Ok(AxisValue::X(M(2000))));
+        assert_eq!(coord(&[6, 0xDC, 0xD8, 30]), Ok(AxisValue::Rz(C(-9000))));
+        // 1..=5 follow pymycobot: 3 is z, not the seed's rx.
+        assert_eq!(coord(&[3, 0x00, 0x64, 30]), Ok(AxisValue::Z(M(100))));
+        assert_eq!(
+            parse(cmd::SEND_COORD, &[7, 0, 0, 30]),
+            Err(CommandError::BadAxis(7))
+        );
+        // Jog coord keeps pymycobot's 1..=6 only.
+        assert_eq!(
+            parse(cmd::JOG_COORD, &[0, 1, 30]),
+            Err(CommandError::BadAxis(0))
+        );
+    }
+
+    #[test]
+    fn my_cobot_basic_pid_and_arc_layouts() {
+        // setPid: FE FE 08 2C p i d p i d FA.
+        assert_eq!(
+            parse(cmd::SET_PID, &[10, 0, 1, 32, 0, 32]),
+            Ok(Request::SetPid {
+                gains: [10, 0, 1, 32, 0, 32]
+            })
+        );
+        assert_eq!(parse(cmd::GET_PID, &[]), Ok(Request::GetPid));
+        assert_eq!(Request::GetPid.reply_kind(), ReplyKind::Bytes6);
+        let pose = |x: i16| Pose {
+            x: crate::units::DeciMm(x),
+            ..Pose::default()
+        };
+        let three = Request::MoveCCoords {
+            begin: pose(1),
+            middle: pose(2),
+            end: pose(3),
+        };
+        let frame = three.to_frame();
+        // MOVEC_COORDS_DEFAULT_LEN 38: three poses, no speed.
+        assert_eq!(frame.data().len(), 36);
+        assert_eq!(Request::parse(&frame), Ok(three));
+        let two = Request::MoveCCoordsFromHere {
+            middle: pose(2),
+            end: pose(3),
+        };
+        assert_eq!(two.to_frame().data().len(), 24);
+        assert_eq!(Request::parse(&two.to_frame()), Ok(two));
+        assert!(matches!(
+            parse(cmd::MOVE_C_COORDS, &[0; 24]),
+            Err(CommandError::BadLength { .. })
+        ));
+    }
+
+    #[test]
+    fn drag_teaching_replies_are_what_pymycobot_parses() {
+        use super::super::{DragPoint, Reply};
+        for r in [
+            Request::DragStartRecord,
+            Request::DragEndRecord,
+            Request::DragGetRecordLen,
+            Request::DragClearRecordData,
+        ] {
+            assert_eq!(r.reply_kind(), ReplyKind::Int16, "{r:?}");
+        }
+        let point = DragPoint {
+            encoders: [2048, 2100, 1990, 2048, 3000, 1024].map(Steps),
+            speeds_steps_per_s: [0, 120, -40, 0, 6000, 1],
+        };
+        let frame = Reply::DragPoint(Some(point)).to_frame(cmd::DRAG_GET_RECORD_DATA);
+        // Joint by joint, encoder then speed: pymycobot takes the even values as encoders.
+        assert_eq!(
+            frame.data().get(..8),
+            Some(&[0x08, 0x00, 0x00, 0x00, 0x08, 0x34, 0x00, 0x78][..])
+        );
+        assert_eq!(
+            Reply::parse(ReplyKind::DragPoint, &frame),
+            Ok(Reply::DragPoint(Some(point)))
+        );
+        let none = Reply::DragPoint(None).to_frame(cmd::DRAG_GET_RECORD_DATA);
+        assert_eq!(none.data(), &[0; 24]);
+        assert_eq!(
+            Reply::parse(ReplyKind::DragPoint, &none),
+            Ok(Reply::DragPoint(None))
+        );
     }
 
     #[test]

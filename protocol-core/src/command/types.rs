@@ -112,6 +112,17 @@ impl Axis {
         }
     }
 
+    /// The axis for the axis byte of send coord (0x24). pymycobot numbers the axes 1..=6
+    /// (x..rz), the seed manual and MyCobotBasic's `writeCoord` 0..=5. Only 0 (x in the seed's
+    /// numbering, no axis in pymycobot's) and 6 (rz, pymycobot's only) say which numbering they
+    /// use; 1..=5 follow pymycobot, the reference client (`protocol.md`: the clients win).
+    pub const fn from_send_coord_byte(v: u8) -> Option<Self> {
+        match v {
+            0 => Some(Self::X),
+            v => Self::from_u8(v),
+        }
+    }
+
     /// Zero-based index into a pose array (x, y, z, rx, ry, rz).
     pub const fn index(self) -> usize {
         self as usize - 1

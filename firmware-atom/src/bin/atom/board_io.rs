@@ -1,11 +1,12 @@
-//! [`AtomIo`] on the chip: the user pins as GPIO or LEDC PWM, the RGB LEDs, the button.
+//! [`AtomIo`] on the chip: the user pins as GPIO or LEDC PWM, the RGB LEDs, the button, and on
+//! the ESP32 the accessory hobby servo on the Grove port (LEDC high-speed group).
 
 use esp_hal::{
     gpio::{DriveMode, Flex, Input, InputConfig, Level, NoPin, OutputSignal, Pull},
     ledc::{
         LowSpeed,
         channel::{self, ChannelHW, ChannelIFace},
-        timer::{self, LSClockSource, Timer, TimerIFace},
+        timer::{self, LSClockSource, Timer, TimerIFace, TimerSpeed},
     },
     time::Rate,
 };
@@ -17,6 +18,8 @@ use crate::{
     leds::Leds,
     pwm::{duty_bits, duty_ticks},
 };
+#[cfg(feature = "esp32")]
+use esp_hal::ledc::{HighSpeed, timer::HSClockSource};
 
 /// Protocol number of the button pin, readable like a user input (`firmware_atom::io`).
 const BUTTON_PIN: u8 = 39;
@@ -37,6 +40,38 @@ pub struct UserPin<'d> {
     pub signal: OutputSignal,
 }
 
+/// The accessory hobby servo's pin (GPIO26, the Grove port) and the LEDC high-speed timer that
+/// times its 50 Hz pulses, with high-speed channel 0 (no user pin uses the high-speed group).
+#[cfg(feature = "esp32")]
+pub struct AccessoryServo<'d> {
+    /// The pin.
+    pub gpio: Flex<'d>,
+    /// High-speed timer 0.
+    pub timer: Timer<'d, HighSpeed>,
+}
+
+#[cfg(feature = "esp32")]
+impl AccessoryServo<'_> {
+    /// Pulses of `pulse_us` every 20 ms, or none (the pin a floating input again).
+    fn set(&mut self, pulse_us: Option<u16>) -> bool {
+        let signal = OutputSignal::LEDC_HS_SIG0;
+        let Some(pulse_us) = pulse_us else {
+            signal.disconnect_from(&self.gpio);
+            make_input(&mut self.gpio, Pull::None);
+            return true;
+        };
+        start_pwm(
+            &mut self.gpio,
+            signal,
+            &mut self.timer,
+            HSClockSource::APBClk,
+            channel::Number::Channel0,
+            crate::pwm::SERVO_FREQ_HZ,
+            |bits| crate::pwm::pulse_ticks(pulse_us, bits),
+        )
+    }
+}
+
 /// The Atom's board IO.
 pub struct BoardIo<'d> {
     /// The user pins, in the order of [`OUTPUT_PINS`].
@@ -47,6 +82,9 @@ pub struct BoardIo<'d> {
     pwm_on: [bool; 4],
     leds: Option<Leds<'d>>,
     button: Input<'d>,
+    /// The accessory hobby servo (ESP32 only).
+    #[cfg(feature = "esp32")]
+    accessory: Option<AccessoryServo<'d>>,
 }
 
 impl<'d> BoardIo<'d> {
@@ -67,7 +105,18 @@ impl<'d> BoardIo<'d> {
             pwm_on: [false; 4],
             leds,
             button,
+            #[cfg(feature = "esp32")]
+            accessory: None,
         }
+    }
+
+    /// The same IO with the accessory hobby servo on `servo`; its pin starts as a floating
+    /// input (no pulses, the servo limp).
+    #[cfg(feature = "esp32")]
+    pub fn with_accessory(mut self, mut servo: AccessoryServo<'d>) -> Self {
+        make_input(&mut servo.gpio, Pull::None);
+        self.accessory = Some(servo);
+        self
     }
 
     /// The user pin with protocol number `pin`, and whether it outputs PWM.
@@ -83,6 +132,52 @@ impl<'d> BoardIo<'d> {
             *pwm_on = false;
         }
     }
+}
+
+/// Starts PWM on `gpio`: `timer` at `freq_hz` from `clock` with the finest duty resolution the
+/// clock allows, LEDC channel `number` at the duty `ticks` gives for that resolution (bits), its
+/// `signal` routed to the pin through the GPIO matrix. `false` if the LEDC refuses.
+fn start_pwm<'d, S>(
+    gpio: &mut Flex<'d>,
+    signal: OutputSignal,
+    timer: &mut Timer<'d, S>,
+    clock: S::ClockSourceType,
+    number: channel::Number,
+    freq_hz: u16,
+    ticks: impl FnOnce(u32) -> u32,
+) -> bool
+where
+    S: TimerSpeed,
+    Timer<'d, S>: TimerIFace<S>,
+{
+    let Some(bits) = duty_bits(freq_hz) else {
+        return false;
+    };
+    let Ok(duty) = timer::config::Duty::try_from(bits) else {
+        return false;
+    };
+    let timer_config = timer::config::Config {
+        duty,
+        clock_source: clock,
+        frequency: Rate::from_hz(u32::from(freq_hz)),
+    };
+    if timer.configure(timer_config).is_err() {
+        return false;
+    }
+    // The channel's signal is routed to the pin by hand below, so the driver gets no pin.
+    let mut pwm = channel::Channel::<S>::new(number, NoPin);
+    let channel_config = channel::config::Config {
+        timer: &*timer,
+        duty_pct: 0,
+        drive_mode: DriveMode::PushPull,
+    };
+    if pwm.configure(channel_config).is_err() {
+        return false;
+    }
+    pwm.set_duty_hw(ticks(bits));
+    signal.connect_to(&*gpio);
+    gpio.set_output_enable(true);
+    true
 }
 
 fn make_input(gpio: &mut Flex<'_>, pull: Pull) {
@@ -128,38 +223,20 @@ impl AtomIo for BoardIo<'_> {
     }
 
     fn set_pwm(&mut self, pin: u8, freq_hz: u16, duty_0_255: u8) -> bool {
-        let Some(bits) = duty_bits(freq_hz) else {
-            return false;
-        };
-        let Ok(duty) = timer::config::Duty::try_from(bits) else {
-            return false;
-        };
         let Some((user, pwm_on)) = self.user_pin(pin) else {
             return false;
         };
-        let timer_config = timer::config::Config {
-            duty,
-            clock_source: LSClockSource::APBClk,
-            frequency: Rate::from_hz(u32::from(freq_hz)),
-        };
-        if user.timer.configure(timer_config).is_err() {
-            return false;
-        }
-        // The channel's signal is routed to the pin by hand below, so the driver gets no pin.
-        let mut pwm = channel::Channel::new(user.channel, NoPin);
-        let channel_config = channel::config::Config {
-            timer: &user.timer,
-            duty_pct: 0,
-            drive_mode: DriveMode::PushPull,
-        };
-        if pwm.configure(channel_config).is_err() {
-            return false;
-        }
-        pwm.set_duty_hw(duty_ticks(duty_0_255, bits));
-        user.signal.connect_to(&user.gpio);
-        user.gpio.set_output_enable(true);
-        *pwm_on = true;
-        true
+        let on = start_pwm(
+            &mut user.gpio,
+            user.signal,
+            &mut user.timer,
+            LSClockSource::APBClk,
+            user.channel,
+            freq_hz,
+            |bits| duty_ticks(duty_0_255, bits),
+        );
+        *pwm_on |= on;
+        on
     }
 
     fn set_rgb(&mut self, red: u8, green: u8, blue: u8) {
@@ -174,5 +251,10 @@ impl AtomIo for BoardIo<'_> {
 
     fn param_store(&mut self) -> Option<&mut dyn ParamStore> {
         Some(&mut self.params)
+    }
+
+    #[cfg(feature = "esp32")]
+    fn set_accessory_servo(&mut self, pulse_us: Option<u16>) -> bool {
+        self.accessory.as_mut().is_some_and(|a| a.set(pulse_us))
     }
 }

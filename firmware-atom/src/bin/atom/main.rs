@@ -86,7 +86,13 @@ fn main() -> ! {
     }
     let button = Input::new(pins.button, InputConfig::default().with_pull(Pull::None));
     let flash = esp_storage::FlashStorage::new(p.FLASH);
-    let mut io = BoardIo::new(user, leds, button, flash);
+    let io = BoardIo::new(user, leds, button, flash);
+    #[cfg(feature = "esp32")]
+    let io = io.with_accessory(board_io::AccessoryServo {
+        gpio: Flex::new(pins.accessory),
+        timer: ledc.timer::<esp_hal::ledc::HighSpeed>(timer::Number::Timer0),
+    });
+    let mut io = io;
 
     let mut atom = Atom::new(AtomConfig::default());
     if let Some(error) = atom.config_error() {

@@ -22,6 +22,9 @@ pub struct AtomPins {
     /// The user pins in the order of `firmware_atom::io::OUTPUT_PINS` (protocol GPIO 19, 22,
     /// 23, 33).
     pub user: [AnyPin<'static>; 4],
+    /// The Grove port's signal pin, for an accessory hobby servo (`firmware_atom::dispenser`).
+    #[cfg(feature = "esp32")]
+    pub accessory: AnyPin<'static>,
 }
 
 #[cfg(feature = "esp32")]

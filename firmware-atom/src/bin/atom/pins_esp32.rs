@@ -17,6 +17,7 @@ macro_rules! take_pins {
                 $p.GPIO23.into(),
                 $p.GPIO33.into(),
             ],
+            accessory: $p.GPIO26.into(),
         }
     };
 }

@@ -14,6 +14,21 @@ pub fn duty_bits(freq_hz: u16) -> Option<u32> {
     Some(ticks_per_period.checked_ilog2()?.min(MAX_DUTY_BITS))
 }
 
+/// Frequency of hobby-servo pulses, Hz: one pulse every 20 ms.
+// Only the ESP32 drives an accessory servo (its LEDC high-speed group).
+#[cfg_attr(not(feature = "esp32"), allow(dead_code))]
+pub const SERVO_FREQ_HZ: u16 = 50;
+/// Period of hobby-servo pulses, microseconds.
+#[cfg_attr(not(feature = "esp32"), allow(dead_code))]
+pub const SERVO_PERIOD_US: u32 = 20_000;
+
+/// The duty register value for a `pulse_us`-long pulse every [`SERVO_PERIOD_US`] at `bits`
+/// resolution (at most the whole period).
+#[cfg_attr(not(feature = "esp32"), allow(dead_code))]
+pub fn pulse_ticks(pulse_us: u16, bits: u32) -> u32 {
+    (u32::from(pulse_us).min(SERVO_PERIOD_US) << bits.min(MAX_DUTY_BITS)) / SERVO_PERIOD_US
+}
+
 /// The duty register value for `duty_0_255` / 255 at `bits` resolution: 0 is always low, 255
 /// always high (`1 << bits`).
 pub fn duty_ticks(duty_0_255: u8, bits: u32) -> u32 {
@@ -41,6 +56,14 @@ mod tests {
     #[test]
     fn zero_hertz_is_refused() {
         assert_eq!(duty_bits(0), None);
+    }
+
+    #[test]
+    fn servo_pulses_are_counted_in_the_20_ms_period() {
+        // 1.5 ms of 20 ms at 14 bits: 1228.8 ticks.
+        assert_eq!(pulse_ticks(1_500, 14), 1_228);
+        assert_eq!(pulse_ticks(1_000, 14), 819);
+        assert_eq!(pulse_ticks(u16::MAX, 14), 1 << 14);
     }
 
     #[test]
