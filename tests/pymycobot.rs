@@ -64,6 +64,8 @@ fn run_suite(python: &Path, robot: &Robot) -> (bool, String) {
         .arg(&e2e)
         .env("MYCOBOT_PORT", &robot.link)
         .env("MYCOBOT_TCP", &robot.tcp)
+        // Started just now: its start-up state is checked, not only reset.
+        .env("MYCOBOT_FRESH", "1")
         .env("PYTHONDONTWRITEBYTECODE", "1")
         .env("PYTHONWARNINGS", "ignore::DeprecationWarning")
         .stdout(Stdio::piped())
