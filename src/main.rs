@@ -59,7 +59,12 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
     };
 
     let mut out = std::io::stdout().lock();
-    writeln!(out, "virtual myCobot 280 on {}", pty.slave_path().display())?;
+    writeln!(
+        out,
+        "virtual myCobot 280: {} on {}",
+        cli.port.serial_name(),
+        pty.slave_path().display()
+    )?;
     if let Some(link) = &link {
         writeln!(out, "pty link {}", link.path().display())?;
     }

@@ -17,7 +17,7 @@ mod launcher;
 use launcher::{Launched, launch};
 #[path = "e2e/venv.rs"]
 mod venv;
-use venv::{python, workspace};
+use venv::{Shown, python, set_up, workspace};
 
 /// The whole Python suite must finish within this (it runs in real time; ~2 min expected).
 const SUITE_DEADLINE: Duration = Duration::from_secs(360);
@@ -64,6 +64,8 @@ fn run_suite(python: &Path, robot: &Robot) -> (bool, String) {
         .arg(&e2e)
         .env("MYCOBOT_PORT", &robot.link)
         .env("MYCOBOT_TCP", &robot.tcp)
+        // Started just now: its start-up state is checked, not only reset.
+        .env("MYCOBOT_FRESH", "1")
         .env("PYTHONDONTWRITEBYTECODE", "1")
         .env("PYTHONWARNINGS", "ignore::DeprecationWarning")
         .stdout(Stdio::piped())
@@ -129,4 +131,18 @@ fn pymycobot_end_to_end_suite() {
         "the robot did not stop cleanly on SIGTERM: {exit:?}"
     );
     assert!(!link_left, "the pty symlink was not removed on exit");
+}
+
+#[test]
+fn an_unreachable_package_index_is_one_clear_message() {
+    // A venv of its own (kept between runs: it never gets the client), and an index nobody
+    // serves, so pip fails at once.
+    let venv = Path::new(env!("CARGO_TARGET_TMPDIR")).join("venv-no-index");
+    let offline = ["--index-url", "http://127.0.0.1:9/", "--retries", "0"];
+    let why = set_up(&venv, &offline, Shown::No).expect_err("installed without an index");
+    assert!(
+        why.starts_with("pip could not install pymycobot==4.0.7 into ")
+            && why.contains("\nIs PyPI reachable from this machine?"),
+        "{why}"
+    );
 }

@@ -1,13 +1,14 @@
-//! The command line of the virtual robot as a user meets it: start-up banner, the pty symlink
-//! (stale ones replaced, user files never clobbered, removed on Ctrl-C), the 3D view's address,
-//! and clear errors. Speaks raw frames on the pseudo-terminal, so it needs no Python.
+//! The command line of the virtual robot as a user meets it: start-up banner (naming the board
+//! whose port it serves), the pty symlink (stale ones replaced, user files never clobbered,
+//! removed on Ctrl-C), the 3D view's address, and clear errors. Speaks raw frames on the
+//! pseudo-terminal, so it needs no Python.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
 use std::fs::{self, OpenOptions};
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream};
 use std::os::unix::fs::symlink;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::mpsc;
 use std::thread;
@@ -41,15 +42,30 @@ fn serves_the_link_replaces_a_stale_one_and_removes_it_on_ctrl_c() {
 
     let mut robot = launch(&["--pty-link", link.to_str().unwrap(), "--no-web"]);
     let pts = robot
-        .banner_value("virtual myCobot 280 on ")
+        .banner_value("virtual myCobot 280: the Basic's USB serial on ")
         .unwrap_or_else(|| panic!("no pty path in the banner: {}", robot.banner));
     assert_eq!(fs::read_link(&link).unwrap(), PathBuf::from(pts));
 
     // Through the link, a raw is_power_on request gets the answer "powered on".
+    assert_powered_on(&link);
+
+    let exit = robot.stop_with(Signal::SIGINT);
+    assert!(
+        exit.is_some_and(|s| s.success()),
+        "exit after Ctrl-C: {exit:?}"
+    );
+    assert!(
+        fs::symlink_metadata(&link).is_err(),
+        "link left behind after Ctrl-C"
+    );
+}
+
+/// Asks the robot on `port` (a path) whether it is powered on; it must say yes within 5 s.
+fn assert_powered_on(port: &Path) {
     let mut port = OpenOptions::new()
         .read(true)
         .write(true)
-        .open(&link)
+        .open(port)
         .unwrap();
     port.write_all(&[0xFE, 0xFE, 0x02, 0x12, 0xFA]).unwrap();
     let (tx, rx) = mpsc::channel();
@@ -61,16 +77,16 @@ fn serves_the_link_replaces_a_stale_one_and_removes_it_on_ctrl_c() {
         .recv_timeout(Duration::from_secs(5))
         .expect("no reply within 5 s");
     assert_eq!(reply.unwrap(), [0xFE, 0xFE, 0x03, 0x12, 0x01, 0xFA]);
+}
 
-    let exit = robot.stop_with(Signal::SIGINT);
-    assert!(
-        exit.is_some_and(|s| s.success()),
-        "exit after Ctrl-C: {exit:?}"
-    );
-    assert!(
-        fs::symlink_metadata(&link).is_err(),
-        "link left behind after Ctrl-C"
-    );
+#[test]
+fn the_start_up_line_names_the_board_whose_port_is_served() {
+    let robot = launch(&["--port", "atom-usb", "--no-web"]);
+    let pts = robot
+        .banner_value("virtual myCobot 280: the Atom's USB serial on ")
+        .unwrap_or_else(|| panic!("no Atom port in the banner: {}", robot.banner));
+    // The Atom answers on its own link, with no Basic in between.
+    assert_powered_on(Path::new(pts));
 }
 
 #[test]

@@ -2,87 +2,21 @@
 //! code, through `tools/pymycobot_replies.py`) as the values the user expects.
 //!
 //! Needs the workspace's Python venv with pymycobot 4.0.7 (`<workspace>/.venv`, or the
-//! interpreter in env `MYCOBOT_PYTHON`). If the venv is missing it is created, under a lock
-//! file so parallel test runs do not race; if that fails the test fails.
+//! interpreter in env `MYCOBOT_PYTHON`), set up on first use by the end-to-end tests' helper
+//! (`tests/e2e/venv.rs`).
 
 // Test code: a panic is a test failure with a message.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)]
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
 
 use protocol_core::command::*;
 use protocol_core::units::{Centideg, Decideg, Steps};
 
-fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("protocol-core sits in the workspace")
-        .to_path_buf()
-}
-
-/// The Python interpreter with pymycobot 4.0.7, creating the venv if needed.
-fn python() -> PathBuf {
-    if let Ok(p) = std::env::var("MYCOBOT_PYTHON") {
-        return PathBuf::from(p);
-    }
-    let root = workspace_root();
-    let py = root.join(".venv/bin/python");
-    if has_pymycobot(&py) {
-        return py;
-    }
-    let lock = root.join(".venv.lock");
-    let deadline = Instant::now() + Duration::from_secs(600);
-    loop {
-        match std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&lock)
-        {
-            Ok(_) => break,
-            Err(_) if Instant::now() < deadline => std::thread::sleep(Duration::from_millis(200)),
-            Err(e) => panic!("waited 10 min for {}: {e}", lock.display()),
-        }
-    }
-    let result = (|| {
-        if has_pymycobot(&py) {
-            return Ok(()); // another run created it while we waited
-        }
-        run(Command::new("python3")
-            .args(["-m", "venv", ".venv"])
-            .current_dir(&root))?;
-        run(Command::new(&py).args(["-m", "pip", "install", "pymycobot==4.0.7"]))
-    })();
-    let _ = std::fs::remove_file(&lock);
-    if let Err(e) = result {
-        panic!(
-            "cannot create the pymycobot venv in {}: {e}",
-            root.display()
-        );
-    }
-    py
-}
-
-fn has_pymycobot(py: &Path) -> bool {
-    py.exists()
-        && Command::new(py)
-            .args([
-                "-c",
-                "import pymycobot; assert pymycobot.__version__ == '4.0.7'",
-            ])
-            .status()
-            .is_ok_and(|s| s.success())
-}
-
-fn run(cmd: &mut Command) -> Result<(), String> {
-    let status = cmd.status().map_err(|e| format!("{cmd:?}: {e}"))?;
-    status
-        .success()
-        .then_some(())
-        .ok_or_else(|| format!("{cmd:?} exited with {status}"))
-}
+#[path = "../../tests/e2e/venv.rs"]
+mod venv;
+use venv::{python, workspace};
 
 struct Case {
     method: &'static str,
@@ -528,7 +462,7 @@ fn pymycobot_reads_our_replies_as_the_values_we_meant() {
             c.want
         );
     }
-    let script = workspace_root().join("tools/pymycobot_replies.py");
+    let script = workspace().join("tools/pymycobot_replies.py");
     let mut child = Command::new(python())
         .arg(&script)
         .stdin(Stdio::piped())

@@ -48,6 +48,16 @@ pub enum Port {
     AtomUsb,
 }
 
+impl Port {
+    /// What the pseudo-terminal stands for, as the start-up line names it.
+    pub fn serial_name(self) -> &'static str {
+        match self {
+            Port::Basic => "the Basic's USB serial",
+            Port::AtomUsb => "the Atom's USB serial",
+        }
+    }
+}
+
 impl From<Port> for HostLink {
     fn from(port: Port) -> Self {
         match port {

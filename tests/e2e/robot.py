@@ -1,11 +1,17 @@
 """Shared helpers for the end-to-end tests: one pymycobot connection to the virtual robot, an
-f64 forward-kinematics reference built from docs/kinematics.md, and waiting helpers.
+f64 forward-kinematics reference of the arm's DH table (kinematics-core's), and waiting
+helpers.
 
 The robot is started by tests/pymycobot.rs (or by hand: `cargo run --release -- --pty-link
 /tmp/mycobot`) and found through the environment:
 
-* MYCOBOT_PORT  the serial device or symlink (default /tmp/mycobot)
-* MYCOBOT_TCP   host:port of the TCP server, for test_tcp.py (skipped when unset)
+* MYCOBOT_PORT   the serial device or symlink (default /tmp/mycobot)
+* MYCOBOT_TCP    host:port of the TCP server, for test_link.py's TCP test (skipped when unset)
+* MYCOBOT_FRESH  1 if the robot was started just for this run (tests/pymycobot.rs sets it)
+
+On first contact the suite notes the robot's start-up state, then resets what the tests rely
+on (`reset`): a robot someone has used works too. Its start-up state is checked only when it
+looks fresh or MYCOBOT_FRESH says it must be.
 """
 
 import math
@@ -17,8 +23,9 @@ import unittest
 from pymycobot import MyCobot280
 
 PORT = os.environ.get("MYCOBOT_PORT", "/tmp/mycobot")
+FRESH = os.environ.get("MYCOBOT_FRESH") == "1"
 
-# The factory joint limits (degrees) from kinematics.md / protocol.md.
+# The factory joint limits (degrees): firmware-atom's FACTORY_LIMITS, docs/protocol.md.
 DEFAULT_MIN = [-168.0, -140.0, -150.0, -150.0, -155.0, -180.0]
 DEFAULT_MAX = [168.0, 140.0, 150.0, 150.0, 160.0, 180.0]
 
@@ -29,19 +36,87 @@ POS_TOL_MM = 0.5
 ROT_TOL_DEG = 0.2
 # Longest any short test move may take (s); moves in the tests are at most ~90 deg at speed 100.
 MOVE_TIMEOUT = 6.0
+# Longest the reset's move home may take (s): from anywhere in the factory range at speed 100.
+HOME_TIMEOUT = 15.0
 
 _arm = None
-# What the robot reported when this suite first connected: (is_power_on, get_angles).
+# What the robot reported when this suite first connected, before the reset:
+# (is_power_on, get_angles).
 first_contact = None
 
 
 def arm():
-    """The one shared MyCobot280 connection (opening costs 1.5 s in pymycobot)."""
+    """The one shared MyCobot280 connection (opening costs 1.5 s in pymycobot). The first call
+    notes the robot's start-up state and resets it."""
     global _arm, first_contact
     if _arm is None:
         _arm = MyCobot280(PORT)
         first_contact = (_arm.is_power_on(), _arm.get_angles())
+        reset(_arm)
     return _arm
+
+
+def looks_fresh(contact):
+    """True if a first contact shows the state a robot starts in: powered on, joints at 0."""
+    powered, angles = contact
+    return powered == 1 and isinstance(angles, list) and all(abs(a) <= ANGLE_TOL for a in angles)
+
+
+def reset(mc):
+    """Puts the robot into the state the tests start from, whatever was done to it before:
+    framed transponder mode, powered on with every servo holding, no error, free mode off,
+    fresh mode on, default speed 100 %, factory joint limits, flange in the base frame with no
+    tool or world offset, joint-interpolated moves, and all joints at 0. What it cannot undo:
+    a servo whose zero was moved (set_servo_calibration) stays so; restart the robot."""
+    zero = [0.0] * 6
+    mc.set_transponder_mode(0)
+    mc.stop()
+    steps = [
+        ("power_on", mc.power_on()),
+        ("clear_error_information", mc.clear_error_information()),
+        ("set_free_mode(0)", mc.set_free_mode(0)),
+        ("set_fresh_mode(1)", mc.set_fresh_mode(1)),
+        ("set speed 100 (0x41)", _raw_ack(mc, frame(0x41, 100))),
+        ("set_end_type(0)", mc.set_end_type(0)),
+        ("set_reference_frame(0)", mc.set_reference_frame(0)),
+        ("set_movement_type(0)", mc.set_movement_type(0)),
+        ("set_tool_reference(0)", mc.set_tool_reference(zero)),
+        ("set_world_reference(0)", mc.set_world_reference(zero)),
+    ]
+    for joint in range(1, 7):
+        steps.append((f"set_joint_min({joint})", mc.set_joint_min(joint, int(DEFAULT_MIN[joint - 1]))))
+        steps.append((f"set_joint_max({joint})", mc.set_joint_max(joint, int(DEFAULT_MAX[joint - 1]))))
+    refused = [name for name, answer in steps if answer != 1]
+    if refused:
+        raise RuntimeError(f"cannot reset the robot on {PORT}: refused {refused}; restart it")
+    if not _near(mc.get_angles(), zero):
+        mc.send_angles(zero, 100)
+        home = wait_until(lambda: _near(mc.get_angles(), zero) and mc.is_moving() == 0, HOME_TIMEOUT)
+        if not home:
+            raise RuntimeError(f"cannot reset the robot on {PORT}: not at 0 after {HOME_TIMEOUT} s")
+    mc.clear_error_information()
+
+
+def _raw_ack(mc, request):
+    """Sends a raw request pymycobot 4.0.7 has no method for; returns its status byte, or None."""
+    port = mc._serial_port
+    with mc.lock:
+        port.reset_input_buffer()
+        port.write(request)
+        reply = b""
+        deadline = time.monotonic() + 0.5
+        while len(reply) < 6 and time.monotonic() < deadline:
+            reply += port.read(6 - len(reply))
+    ok = len(reply) == 6 and reply[:4] == bytes([0xFE, 0xFE, 0x03, request[3]]) and reply[5] == 0xFA
+    return reply[4] if ok else None
+
+
+def _near(angles, expected):
+    return (
+        isinstance(angles, list)
+        and len(angles) == len(expected)
+        and all(abs(a - e) <= ANGLE_TOL for a, e in zip(angles, expected))
+    )
 
 
 def frame(cmd, *data):
@@ -66,7 +141,8 @@ def wait_until(predicate, timeout, interval=0.02):
 
 # ---------------------------------------------------------------- f64 kinematics reference
 
-# Standard DH (kinematics.md): (d mm, a mm, alpha deg, theta offset deg) per joint.
+# Standard DH (kinematics-core's ArmGeometry::MYCOBOT_280): (d mm, a mm, alpha deg, theta
+# offset deg) per joint.
 DH = [
     (131.22, 0.0, 90.0, 0.0),
     (0.0, -110.4, 0.0, -90.0),

@@ -8,6 +8,11 @@ from robot import RobotTestCase, wait_until
 
 class StatusTest(RobotTestCase):
     def test_starts_powered_on_with_all_joints_at_zero(self):
+        if not robot.FRESH and not robot.looks_fresh(robot.first_contact):
+            self.skipTest(
+                "the robot was used before this run (reset since): its start-up state is checked "
+                "on a robot started for the run (MYCOBOT_FRESH=1)"
+            )
         powered, angles = robot.first_contact
         self.assertEqual(powered, 1, "not powered on at start-up")
         self.assertAnglesClose(angles, [0] * 6, msg="angles at start-up")
