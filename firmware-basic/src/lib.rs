@@ -47,6 +47,7 @@ pub mod local;
 pub mod status;
 mod supervisor;
 pub mod transparent;
+pub mod wifi;
 
 pub use config::{BasicConfig, ConfigError, EchoMode};
 pub use io::{BasicIo, Buttons, NullIo};
