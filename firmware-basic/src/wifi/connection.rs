@@ -17,8 +17,8 @@
 //!   [`Station::poll`].
 //! * Outputs: [`Station::poll`] returns the next [`Action`] for the driver (join with these
 //!   credentials, leave, start DHCP, take the network down), one at a time, in order.
-//! * [`Station::status`] is what the LCD shows (with the SSID, port and client count in
-//!   [`WifiStatus`](super::WifiStatus)).
+//! * [`Station::state`], [`Station::last_failure`]: what the LCD shows (with the SSID, port
+//!   and client count, in [`WifiStatus`](super::WifiStatus)).
 //!
 //! Every join has an attempt number; events of an older attempt (a join the driver was still
 //! finishing when the credentials changed) are ignored.

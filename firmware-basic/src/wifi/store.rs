@@ -2,7 +2,7 @@
 //!
 //! * [`WifiStore`]: the tiny storage trait (load, save the whole [`WifiSettings`]).
 //! * [`FlashWifiStore`]: the settings as one record ([`WifiSettings::encode`]) under
-//!   [`SETTINGS_KEY`] in a `flash_store::FlashStore` (sequential-storage's wear-levelling map)
+//!   [`SETTINGS_KEY`] in a `flash_store::FlashStore` (through a `flash_store::FlashRange`) (sequential-storage's wear-levelling map)
 //!   over any embedded-storage NOR flash: esp-storage on the board, `flash_store::MemFlash` in
 //!   the tests and the virtual robot. A write is all or nothing: an interrupted or failed one
 //!   leaves the previous record readable.
@@ -18,7 +18,7 @@
 use core::ops::Range;
 
 use embedded_storage::nor_flash::NorFlash;
-use flash_store::{FlashStore, StoreError};
+use flash_store::{FlashRange, StoreError};
 
 use super::config::{Credentials, MAX_RECORD, SettingsError, WifiSettings};
 
@@ -42,57 +42,35 @@ pub enum LoadError {
     Record(SettingsError),
 }
 
-/// The Wi-Fi settings in a range of NOR flash, through [`FlashStore`]. See the
+/// The Wi-Fi settings in a range of NOR flash, through [`flash_store::FlashStore`]. See the
 /// [module doc](self).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FlashWifiStore<F> {
-    /// Always `Some` between calls; taken while a [`FlashStore`] borrows it.
-    flash: Option<F>,
-    range: Range<u32>,
+    region: FlashRange<F>,
 }
 
 impl<F: NorFlash> FlashWifiStore<F> {
     /// Settings kept in `range` of `flash` (whole erase pages, at least two).
     pub fn new(flash: F, range: Range<u32>) -> Self {
         Self {
-            flash: Some(flash),
-            range,
+            region: FlashRange::new(flash, range),
         }
     }
 
     /// The flash behind the store (tests; the virtual robot saves it to a file).
     pub fn flash(&self) -> Option<&F> {
-        self.flash.as_ref()
+        self.region.flash()
+    }
+
+    /// The flash, to change it behind the store (tests: a failing flash).
+    pub fn flash_mut(&mut self) -> Option<&mut F> {
+        self.region.flash_mut()
     }
 
     /// The flash, given back.
     pub fn into_flash(self) -> Option<F> {
-        self.flash
+        self.region.into_flash()
     }
-
-    fn with_store<T, E: From<StoreError>>(
-        &mut self,
-        act: impl FnOnce(&mut FlashStore<F>) -> Result<T, E>,
-    ) -> Result<T, E> {
-        // `FlashStore::new` keeps the flash it refuses: check the range before handing it over.
-        if !range_fits::<F>(&self.range) {
-            return Err(StoreError::Invalid.into());
-        }
-        let flash = self.flash.take().ok_or(StoreError::Flash)?;
-        let mut store = FlashStore::new(flash, self.range.clone())?;
-        let result = act(&mut store);
-        self.flash = Some(store.into_flash());
-        result
-    }
-}
-
-/// True if `range` is what a [`FlashStore`] takes: whole erase pages, at least two.
-fn range_fits<F: NorFlash>(range: &Range<u32>) -> bool {
-    let page = F::ERASE_SIZE as u32;
-    page > 0
-        && range.start.is_multiple_of(page)
-        && range.end.is_multiple_of(page)
-        && range.end.saturating_sub(range.start) >= 2 * page
 }
 
 impl From<StoreError> for LoadError {
@@ -103,7 +81,7 @@ impl From<StoreError> for LoadError {
 
 impl<F: NorFlash> WifiStore for FlashWifiStore<F> {
     fn load(&mut self) -> Result<Option<WifiSettings>, LoadError> {
-        self.with_store(|store| {
+        self.region.with_store(|store| {
             let mut record = [0u8; MAX_RECORD];
             match store.fetch(SETTINGS_KEY, &mut record) {
                 Ok(Some(len)) => {
@@ -123,7 +101,8 @@ impl<F: NorFlash> WifiStore for FlashWifiStore<F> {
     }
 
     fn save(&mut self, settings: &WifiSettings) -> Result<(), StoreError> {
-        self.with_store(|store| store.store(SETTINGS_KEY, &settings.encode()))
+        self.region
+            .with_store(|store| store.store(SETTINGS_KEY, &settings.encode()))
     }
 }
 
@@ -249,7 +228,7 @@ mod tests {
     }
 
     fn flash_mut(store: &mut Store) -> &mut Flash {
-        store.flash.as_mut().unwrap()
+        store.flash_mut().unwrap()
     }
 
     #[test]
@@ -343,7 +322,7 @@ mod tests {
 
     #[test]
     fn an_unreadable_record_means_defaults_until_the_next_change_repairs_it() {
-        let mut flash_store = FlashStore::new(Flash::new(), RANGE).unwrap();
+        let mut flash_store = flash_store::FlashStore::new(Flash::new(), RANGE).unwrap();
         flash_store.store(SETTINGS_KEY, &[9, 9, 9]).unwrap();
         let mut store = FlashWifiStore::new(flash_store.into_flash(), RANGE);
         let mut config = WifiConfig::load(&mut store);
