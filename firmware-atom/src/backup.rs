@@ -19,7 +19,7 @@
 use core::ops::Range;
 
 use embedded_storage::nor_flash::NorFlash;
-use flash_store::{FlashStore, StoreError};
+use flash_store::{FlashRange, StoreError};
 use protocol_core::Frame;
 use protocol_core::command::{ServoSelect, cmd};
 use protocol_core::servo::reg;
@@ -53,44 +53,31 @@ pub trait ParamStore {
     fn save(&mut self, id: u8, block: &Block) -> Result<(), StoreError>;
 }
 
-/// Servo parameter blocks in a range of NOR flash, through [`FlashStore`] (wear-levelled,
+/// Servo parameter blocks in a range of NOR flash, through [`flash_store::FlashStore`] (wear-levelled,
 /// power-fail safe). The board binds it to the Atom's flash (esp-storage), the virtual robot
 /// and the tests to [`flash_store::MemFlash`].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FlashParams<F> {
-    flash: Option<F>,
-    range: Range<u32>,
+    region: FlashRange<F>,
 }
 
 impl<F: NorFlash> FlashParams<F> {
     /// Blocks kept in `range` of `flash` (whole erase pages, at least two).
     pub fn new(flash: F, range: Range<u32>) -> Self {
         Self {
-            flash: Some(flash),
-            range,
+            region: FlashRange::new(flash, range),
         }
     }
 
     /// The flash, for a look at what is stored (tests, saving the virtual robot's flash).
     pub fn flash(&self) -> Option<&F> {
-        self.flash.as_ref()
-    }
-
-    fn with_store<T>(
-        &mut self,
-        act: impl FnOnce(&mut FlashStore<F>) -> Result<T, StoreError>,
-    ) -> Result<T, StoreError> {
-        let flash = self.flash.take().ok_or(StoreError::Flash)?;
-        let mut store = FlashStore::new(flash, self.range.clone())?;
-        let result = act(&mut store);
-        self.flash = Some(store.into_flash());
-        result
+        self.region.flash()
     }
 }
 
 impl<F: NorFlash> ParamStore for FlashParams<F> {
     fn load(&mut self, id: u8) -> Result<Option<Block>, StoreError> {
-        self.with_store(|store| {
+        self.region.with_store(|store| {
             let mut block = [0u8; BLOCK_LEN];
             match store.fetch(id, &mut block)? {
                 Some(BLOCK_LEN) => Ok(Some(block)),
@@ -101,7 +88,7 @@ impl<F: NorFlash> ParamStore for FlashParams<F> {
     }
 
     fn save(&mut self, id: u8, block: &Block) -> Result<(), StoreError> {
-        self.with_store(|store| store.store(id, block))
+        self.region.with_store(|store| store.store(id, block))
     }
 }
 

@@ -62,6 +62,7 @@ pub mod router;
 pub mod status;
 mod supervisor;
 pub mod transparent;
+pub mod wifi;
 
 pub use config::{BasicConfig, ConfigError, EchoMode};
 pub use host_link::LinkKind;

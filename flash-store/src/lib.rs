@@ -145,6 +145,63 @@ impl<F: NorFlash> FlashStore<F> {
     }
 }
 
+/// A flash and the range a [`FlashStore`] lives in, the store made afresh for each use: the
+/// flash stays here between uses, to be looked at or saved (the virtual robot keeps it in a
+/// file). What the Atom's parameter backups and the Basic's Wi-Fi settings are kept in.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FlashRange<F> {
+    /// Always `Some` between uses; taken while a [`FlashStore`] borrows it.
+    flash: Option<F>,
+    range: Range<u32>,
+}
+
+impl<F: NorFlash> FlashRange<F> {
+    /// A store in `range` of `flash` (whole erase pages, at least two; another range makes
+    /// every use fail with [`StoreError::Invalid`]).
+    pub fn new(flash: F, range: Range<u32>) -> Self {
+        Self {
+            flash: Some(flash),
+            range,
+        }
+    }
+
+    /// The flash, for a look at what is stored (tests, saving the virtual robot's flash).
+    pub fn flash(&self) -> Option<&F> {
+        self.flash.as_ref()
+    }
+
+    /// The flash, to change it behind the store (tests: a failing flash).
+    pub fn flash_mut(&mut self) -> Option<&mut F> {
+        self.flash.as_mut()
+    }
+
+    /// The flash, given back.
+    pub fn into_flash(self) -> Option<F> {
+        self.flash
+    }
+
+    /// Runs `act` on the store. The flash is kept whatever happens, also when the range is
+    /// refused ([`FlashStore::new`] would drop it).
+    pub fn with_store<T, E: From<StoreError>>(
+        &mut self,
+        act: impl FnOnce(&mut FlashStore<F>) -> Result<T, E>,
+    ) -> Result<T, E> {
+        let page = F::ERASE_SIZE as u32;
+        let fits = page > 0
+            && self.range.start.is_multiple_of(page)
+            && self.range.end.is_multiple_of(page)
+            && self.range.end.saturating_sub(self.range.start) >= 2 * page;
+        if !fits {
+            return Err(StoreError::Invalid.into());
+        }
+        let flash = self.flash.take().ok_or(StoreError::Flash)?;
+        let mut store = FlashStore::new(flash, self.range.clone())?;
+        let result = act(&mut store);
+        self.flash = Some(store.into_flash());
+        result
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -197,6 +254,20 @@ mod tests {
         let mut out = [0u8; 2];
         assert_eq!(store.fetch(1, &mut out), Ok(Some(2)));
         assert_eq!(out, [1, 1]);
+    }
+
+    #[test]
+    fn a_flash_range_keeps_its_flash_even_when_the_range_is_refused() {
+        let mut range = FlashRange::new(Flash::new(), 0..4 * 4096);
+        range.with_store(|s| s.store(1, &[7])).unwrap();
+        let mut out = [0u8; 1];
+        assert_eq!(range.with_store(|s| s.fetch(1, &mut out)), Ok(Some(1)));
+        let mut bad = FlashRange::new(range.into_flash().unwrap(), 100..4096);
+        assert_eq!(
+            bad.with_store(|s| s.fetch(1, &mut out)),
+            Err(StoreError::Invalid)
+        );
+        assert!(bad.flash().is_some());
     }
 
     #[test]

@@ -501,8 +501,9 @@ pub enum Request {
         /// Pin.
         pin: BasicInputPin,
     },
-    /// 0xB0 set Wi-Fi SSID and password: raw bytes as pymycobot sends them (empty first,
-    /// then the strings).
+    /// 0xB0 set Wi-Fi SSID and password. pymycobot sends it empty (an announcing frame) and
+    /// the credentials 20 ms later as bare text `'ssid'(password)`, outside any frame; a
+    /// client may also frame that text here (`firmware_basic::wifi::config`).
     SetSsidPwd {
         /// Payload.
         payload: Vec<u8, MAX_DATA>,

@@ -1,5 +1,7 @@
 //! Host tests of the Basic board binary's hardware-free parts; the binary itself builds only
 //! for a chip (docs/boards.md).
 
+#[path = "loop_time.rs"]
+mod loop_time;
 #[path = "screen_text.rs"]
 mod screen_text;

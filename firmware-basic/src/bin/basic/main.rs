@@ -4,6 +4,9 @@
 //! * UART1 at 1 Mbaud: the shared bus (servos and the Atom).
 //! * GPIO: user outputs and inputs, front buttons; the speaker is held silent.
 //! * SPI: the ILI9342C LCD, showing the transponder's status one character per loop pass.
+//! * With the `wifi` feature: the Wi-Fi station and TCP server ([`network`]), under the esp-rtos
+//!   scheduler that esp-radio needs (the loop below is its main task, preempted by the radio's
+//!   tasks), with a heap of [`RECLAIMED_HEAP_BYTES`] + [`HEAP_BYTES`].
 //!
 //! Pins per chip are in [`pins`]; docs/boards.md says how to build and flash.
 #![no_std]
@@ -15,7 +18,13 @@ compile_error!(
     "the basic board binary builds only for a chip: `cargo build-basic-c3` or `cargo +esp build-basic` (docs/boards.md)"
 );
 
+#[cfg(feature = "wifi")]
+extern crate alloc;
+
 mod board_io;
+mod loop_time;
+#[cfg(feature = "wifi")]
+mod network;
 mod pins;
 mod screen;
 mod screen_text;
@@ -44,7 +53,9 @@ use mipidsi::{
 };
 use protocol_core::timing::{BUS_BAUD, HOST_BAUD};
 
-use crate::{board_io::BoardIo, screen::StatusScreen};
+use crate::{
+    board_io::BoardIo, loop_time::LoopTime, screen::StatusScreen, screen_text::BoardStatus,
+};
 use board_support::{LoopWatchdog, UartPort, board_log, now_us};
 
 esp_bootloader_esp_idf::esp_app_desc!();
@@ -53,6 +64,14 @@ esp_bootloader_esp_idf::esp_app_desc!();
 const LCD_SPI_MHZ: u32 = 40;
 /// Bytes mipidsi batches per SPI write.
 const LCD_BUFFER_BYTES: usize = 512;
+/// Heap for esp-radio (driver buffers, its tasks' stacks and event channels) and the TCP/IP
+/// stack's buffers (about 9 KiB), 100 KiB as in esp-hal's Wi-Fi examples: this part in the RAM
+/// the ESP-IDF bootloader used (free once the application runs, outside `.bss`)...
+#[cfg(feature = "wifi")]
+const RECLAIMED_HEAP_BYTES: usize = 64 * 1024;
+/// ... and this part in `.bss`.
+#[cfg(feature = "wifi")]
+const HEAP_BYTES: usize = 36 * 1024;
 
 #[main]
 fn main() -> ! {
@@ -107,13 +126,43 @@ fn main() -> ! {
 
     let mut basic = Basic::new(BasicConfig::default());
 
+    // Wi-Fi needs the scheduler running before the radio starts; a radio that does not start
+    // leaves the transponder running without Wi-Fi.
+    #[cfg(feature = "wifi")]
+    let (mut network, mut tcp_clients) = {
+        esp_alloc::heap_allocator!(#[esp_hal::ram(reclaimed)] size: RECLAIMED_HEAP_BYTES);
+        esp_alloc::heap_allocator!(size: HEAP_BYTES);
+        let timg0 = esp_hal::timer::timg::TimerGroup::new(p.TIMG0);
+        esp_rtos::start(timg0.timer0, p.FROM_CPU_INTR0);
+        let rng = esp_hal::rng::Rng::new();
+        let seed = (u64::from(rng.random()) << 32) | u64::from(rng.random());
+        let network = network::Network::start(now_us(), p.WIFI, p.FLASH, seed);
+        if network.is_err() {
+            board_log!("Wi-Fi did not start; running without it");
+        }
+        // INTEGRATION POINT: the router takes TCP clients' bytes here once it is merged.
+        (network.ok(), network::DiscardClients::default())
+    };
+
     let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, now_us());
+    let mut loop_time = LoopTime::default();
 
     loop {
         let now = now_us();
+        loop_time.pass(now);
         basic.poll(now, &mut host, &mut bus, &mut io);
+        #[cfg(feature = "wifi")]
+        if let Some(network) = &mut network {
+            network.poll(now, &mut tcp_clients);
+        }
         if let Some(screen) = &mut screen {
-            screen.update(now, basic.status());
+            screen.update(now, basic.status(), || BoardStatus {
+                loop_max_us: loop_time.max_us(),
+                #[cfg(feature = "wifi")]
+                wifi: network.as_ref().map(network::Network::status),
+                #[cfg(not(feature = "wifi"))]
+                wifi: None,
+            });
             screen.draw_next();
         }
         watchdog.pass(now);

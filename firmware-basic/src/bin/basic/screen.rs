@@ -11,7 +11,9 @@ use embedded_graphics::{
 };
 use firmware_basic::BasicStatus;
 
-use crate::screen_text::{self, Cell, ERROR_ROW, TITLE_ROW, TextGrid};
+use crate::screen_text::{
+    self, BoardStatus, Cell, ERROR_ROW, NET_ROW, TITLE_ROW, TextGrid, WIFI_ROW,
+};
 
 /// Cell size of `FONT_10X20`, in pixels.
 const CELL_WIDTH_PX: i32 = 10;
@@ -23,7 +25,7 @@ const REFORMAT_INTERVAL_US: u64 = 200_000;
 pub struct StatusScreen<D> {
     display: D,
     grid: TextGrid,
-    last_status: Option<BasicStatus>,
+    last_status: Option<(BasicStatus, BoardStatus)>,
     formatted_at_us: u64,
 }
 
@@ -38,15 +40,23 @@ impl<D: DrawTarget<Color = Rgb565>> StatusScreen<D> {
         }
     }
 
-    /// Notes the transponder's `status` at `now_us`; the text follows within
-    /// [`REFORMAT_INTERVAL_US`] when it changed.
-    pub fn update(&mut self, now_us: u64, status: BasicStatus) {
-        let changed = self.last_status != Some(status);
+    /// Notes the transponder's `status` and the `board`'s at `now_us`; the text follows within
+    /// [`REFORMAT_INTERVAL_US`] when it changed. `board` is asked for only then.
+    pub fn update(
+        &mut self,
+        now_us: u64,
+        status: BasicStatus,
+        board: impl FnOnce() -> BoardStatus,
+    ) {
         let due = now_us.wrapping_sub(self.formatted_at_us) >= REFORMAT_INTERVAL_US;
-        if changed && (due || self.last_status.is_none()) {
-            self.last_status = Some(status);
+        if !due && self.last_status.is_some() {
+            return;
+        }
+        let now = (status, board());
+        if self.last_status.as_ref() != Some(&now) {
             self.formatted_at_us = now_us;
-            self.grid.set(screen_text::render(&status));
+            self.grid.set(screen_text::render(&now.0, &now.1));
+            self.last_status = Some(now);
         }
     }
 
@@ -58,6 +68,7 @@ impl<D: DrawTarget<Color = Rgb565>> StatusScreen<D> {
         let color = match row {
             TITLE_ROW => Rgb565::YELLOW,
             ERROR_ROW => Rgb565::RED,
+            WIFI_ROW | NET_ROW => Rgb565::CYAN,
             _ => Rgb565::WHITE,
         };
         // An opaque background makes each character overwrite its whole cell.

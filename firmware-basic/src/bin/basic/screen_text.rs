@@ -4,6 +4,7 @@
 
 use core::fmt::{self, Write};
 
+use firmware_basic::wifi::{Failure, JoinFailure, StationState, WifiStatus};
 use firmware_basic::{AtomLink, BasicError, BasicStatus, TransponderMode};
 
 /// Text columns: 320 px / 10 px.
@@ -14,20 +15,85 @@ pub const ROWS: usize = 12;
 pub const TITLE_ROW: usize = 0;
 /// The row with the last error.
 pub const ERROR_ROW: usize = 10;
+/// The row with the loop's longest pass gap lately.
+pub const LOOP_ROW: usize = 1;
+/// The row with the Wi-Fi network and the station's state (Wi-Fi builds).
+pub const WIFI_ROW: usize = 9;
+/// The row with the address and port clients connect to, and how many are connected (or why
+/// the station is not online).
+pub const NET_ROW: usize = 11;
 
 /// A screenful of ASCII characters.
 pub type Text = [[u8; COLS]; ROWS];
 
-/// The screen text for `status`.
-pub fn render(status: &BasicStatus) -> Text {
+/// What the board shows besides the transponder's status.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct BoardStatus {
+    /// The longest gap between two passes of the loop lately, microseconds
+    /// ([`crate::loop_time`]).
+    pub loop_max_us: u32,
+    /// Wi-Fi, in a Wi-Fi build.
+    pub wifi: Option<WifiStatus>,
+}
+
+/// The screen text for the transponder's `status` and the `board`'s.
+pub fn render(status: &BasicStatus, board: &BoardStatus) -> Text {
     let mut text = [[b' '; COLS]; ROWS];
     for (row, cells) in text.iter_mut().enumerate() {
         let mut line = Line::default();
         // `Line` never fails: what does not fit is cut off.
-        let _ = write_row(&mut line, row, status);
+        let _ = match (row, &board.wifi) {
+            (LOOP_ROW, _) => write!(line, "loop max  {} us", board.loop_max_us),
+            (WIFI_ROW | NET_ROW, Some(wifi)) => write_wifi_row(&mut line, row, wifi),
+            _ => write_row(&mut line, row, status),
+        };
         *cells = line.cells;
     }
     text
+}
+
+/// Writes Wi-Fi row `row` (`WIFI_ROW` or `NET_ROW`).
+fn write_wifi_row(out: &mut Line, row: usize, wifi: &WifiStatus) -> fmt::Result {
+    let Some(ssid) = &wifi.ssid else {
+        return match row {
+            WIFI_ROW if wifi.settings_unreadable => write!(out, "wifi  off (settings lost)"),
+            WIFI_ROW => write!(out, "wifi  off"),
+            _ => write!(out, "port {}", wifi.port),
+        };
+    };
+    if row == WIFI_ROW {
+        let state = match wifi.state {
+            StationState::Off => "off",
+            StationState::Joining { .. } => "joining",
+            StationState::GettingAddress { .. } => "DHCP",
+            StationState::Online { .. } => "on",
+            StationState::Waiting { .. } => "retry",
+        };
+        return write!(out, "wifi  {state:<8}{ssid}");
+    }
+    match (wifi.state, wifi.last_failure) {
+        (StationState::Online { address }, _) => {
+            let plural = if wifi.clients == 1 { "" } else { "s" };
+            write!(
+                out,
+                "{address}:{}  {} client{plural}",
+                wifi.port, wifi.clients
+            )
+        }
+        (_, Some(failure)) => write!(
+            out,
+            "{}",
+            match failure {
+                Failure::Join(JoinFailure::NotFound) => "network not found",
+                Failure::Join(JoinFailure::AuthFailed) => "wrong password?",
+                Failure::Join(JoinFailure::Other) => "join failed",
+                Failure::JoinTimeout => "join timed out",
+                Failure::NoAddress => "no DHCP address",
+                Failure::LinkLost => "link lost",
+            }
+        ),
+        _ => write!(out, "port {}", wifi.port),
+    }
 }
 
 /// Writes the text of screen row `row`.
@@ -202,7 +268,7 @@ mod tests {
             timeouts: 3,
             ..BasicStatus::default()
         };
-        let text = render(&status);
+        let text = render(&status, &BoardStatus::default());
         assert_eq!(row_text(&text, TITLE_ROW), "open myCobot Basic  v1.2");
         assert_eq!(row_text(&text, 2), "mode      framed");
         assert_eq!(row_text(&text, 3), "atom      SILENT");
@@ -210,6 +276,43 @@ mod tests {
         assert_eq!(row_text(&text, 5), "bus echo  ?");
         assert_eq!(row_text(&text, 8), "timeouts 3  collisions 0");
         assert_eq!(row_text(&text, ERROR_ROW), "no reply to 0x20");
+    }
+
+    #[test]
+    fn wifi_rows_show_network_address_port_and_clients() {
+        let basic = BasicStatus::default();
+        let mut wifi = WifiStatus {
+            ssid: Some("robots".try_into().unwrap()),
+            state: StationState::Online {
+                address: core::net::Ipv4Addr::new(192, 168, 100, 200),
+            },
+            port: 65535,
+            clients: 7,
+            last_failure: None,
+            settings_unreadable: false,
+        };
+        let board = |wifi: &WifiStatus| BoardStatus {
+            loop_max_us: 412,
+            wifi: Some(wifi.clone()),
+        };
+        let text = render(&basic, &board(&wifi));
+        assert_eq!(row_text(&text, LOOP_ROW), "loop max  412 us");
+        assert_eq!(row_text(&text, WIFI_ROW), "wifi  on      robots");
+        assert_eq!(row_text(&text, NET_ROW), "192.168.100.200:65535  7 clients");
+        wifi.state = StationState::Waiting { retry_at_us: 0 };
+        wifi.last_failure = Some(Failure::Join(JoinFailure::AuthFailed));
+        let text = render(&basic, &board(&wifi));
+        assert_eq!(row_text(&text, WIFI_ROW), "wifi  retry   robots");
+        assert_eq!(row_text(&text, NET_ROW), "wrong password?");
+        wifi.ssid = None;
+        wifi.state = StationState::Off;
+        let text = render(&basic, &board(&wifi));
+        assert_eq!(row_text(&text, WIFI_ROW), "wifi  off");
+        assert_eq!(row_text(&text, NET_ROW), "port 65535");
+        // Without Wi-Fi the rows stay blank.
+        let text = render(&basic, &BoardStatus::default());
+        assert_eq!(row_text(&text, WIFI_ROW), "");
+        assert_eq!(row_text(&text, NET_ROW), "");
     }
 
     #[test]
@@ -225,7 +328,7 @@ mod tests {
     #[test]
     fn a_cleared_screen_draws_only_the_non_blank_cells_once() {
         let mut grid = TextGrid::new();
-        let text = render(&BasicStatus::default());
+        let text = render(&BasicStatus::default(), &BoardStatus::default());
         grid.set(text);
         let cells = drain(&mut grid);
         let non_blank = text.iter().flatten().filter(|&&b| b != b' ').count();
