@@ -179,7 +179,7 @@ mod tests {
     fn zero_pose_matches_the_vendor_model() {
         let mut c = Cartesian::new(&DEFAULT_LIMITS);
         let p = c.forward(&[Centideg(0); JOINTS]);
-        // kinematics.md: flange at (45.6, -63.4, 412.67) mm, (-90, 0, -90) deg.
+        // docs/kinematics.md: flange at (45.6, -63.4, 412.67) mm, (-90, 0, -90) deg.
         assert!((i32::from(p.x.0) - 456).abs() <= 1, "{p:?}");
         assert!((i32::from(p.y.0) + 634).abs() <= 1, "{p:?}");
         assert!((i32::from(p.z.0) - 4127).abs() <= 1, "{p:?}");

@@ -10,7 +10,7 @@ pub const SERVOS: usize = 7;
 /// Index of the gripper in per-servo arrays (servo id 7 on the real arm).
 pub const GRIPPER: usize = 6;
 
-/// Encoder steps per full turn (`servo-bus.md`).
+/// Encoder steps per full turn (`docs/servo-bus.md`).
 pub const STEPS_PER_TURN: i32 = 4096;
 /// Encoder reading at 0 degrees.
 pub const STEPS_ZERO: i32 = 2048;
@@ -49,9 +49,9 @@ impl JointLimit {
 }
 
 /// The factory joint range of the myCobot 280 M5, degrees: J1 +-168, J2 +-140, J3 +-150,
-/// J4 +-150, J5 -155..+160, J6 +-180. Source: the current vendor firmware as documented in
-/// `kinematics.md`, and pymycobot 4.0.7's own table for `MyCobot280` (`robot_info.py`,
-/// `angles_min` / `angles_max`). A hard outer bound: the limits may be narrowed at run time
+/// J4 +-150, J5 -155..+160, J6 +-180. Source: pymycobot 4.0.7's own table for `MyCobot280`
+/// (`robot_info.py`, `angles_min` / `angles_max`), the range the vendor's client enforces
+/// (`docs/kinematics.md`). A hard outer bound: the limits may be narrowed at run time
 /// (0x4C/0x4D), never widened beyond it.
 pub const FACTORY_LIMITS: [JointLimit; JOINTS] = [
     JointLimit::degrees(-168, 168),
@@ -65,7 +65,7 @@ pub const FACTORY_LIMITS: [JointLimit; JOINTS] = [
 /// The joint limits at boot: the factory range.
 pub const DEFAULT_LIMITS: [JointLimit; JOINTS] = FACTORY_LIMITS;
 
-/// Speeds and accelerations at 100 % (`kinematics.md`: joints up to 150 deg/s and 200 deg/s^2,
+/// Speeds and accelerations at 100 % (`docs/kinematics.md`: joints up to 150 deg/s and 200 deg/s^2,
 /// Cartesian up to 100 mm/s), and what the servos can do.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MotionLimits {
@@ -130,7 +130,7 @@ pub struct TimingBudget {
     /// 0 on the arm) plus scheduling jitter of the board loop.
     pub reply_margin_us: u64,
     /// How often a servo transaction that expects a reply is retried after a timeout or a bad
-    /// checksum before the command fails (`servo-bus.md`: corrupted replies are retried).
+    /// checksum before the command fails (`docs/servo-bus.md`: corrupted replies are retried).
     pub retries: u8,
     /// Consecutive missed state reads after which a servo is reported as not answering. Three
     /// misses = three refresh rounds, about 12 ms: one collision never marks a servo dead.

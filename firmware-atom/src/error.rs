@@ -27,8 +27,9 @@ pub enum AtomError {
 }
 
 impl AtomError {
-    /// The error code 0x07 reports for this failure (`protocol.md` section 5), if it has one:
-    /// 1..=6 joint limit, 32 unreachable pose, 33 / 34 no continuous straight line.
+    /// The error code 0x07 reports for this failure (`docs/protocol.md` section 7), if it has one:
+    /// 1..=6 joint limit, 32 unreachable pose, 33 / 34 no continuous path (or an arc without a
+    /// circle, 33).
     pub fn error_code(self) -> Option<ErrorCode> {
         match self {
             Self::JointLimit(j) => u8::try_from(j + 1)

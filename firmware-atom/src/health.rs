@@ -3,7 +3,7 @@
 use protocol_core::units::Steps;
 
 /// The latest state read from one servo (registers 40..=70: torque, goal, present state;
-/// `servo-bus.md`).
+/// `docs/servo-bus.md`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ServoHealth {
     /// True while the servo answers; false after

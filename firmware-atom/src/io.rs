@@ -4,7 +4,7 @@
 //! trait, so an implementation only has to drive the hardware; it may still refuse (return
 //! `false` / `None`), which the library reports to the host as a failed command.
 
-/// The Atom pins clients may drive as outputs or read (`protocol.md` section 5, `hardware.md`).
+/// The Atom pins clients may drive as outputs or read (`docs/protocol.md` sections 5 and 18).
 pub const OUTPUT_PINS: [u8; 4] = [19, 22, 23, 33];
 /// The Atom pins clients may read: the IO pins plus the button on GPIO39 (input only).
 pub const INPUT_PINS: [u8; 5] = [19, 22, 23, 33, 39];

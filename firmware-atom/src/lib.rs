@@ -1,18 +1,19 @@
 //! The myCobot 280 M5 Atom firmware as a hardware-free library.
 //!
 //! The Atom is the brain of the arm: it owns the shared 1 Mbaud bus, answers the host commands
-//! of `protocol.md`, drives the six joint servos and the gripper (`servo-bus.md`), the LEDs and
-//! the user pins, and runs the kinematics. Everything here is a state machine polled with the
-//! time ([`Atom::poll`]); the board layer (`src/bin`) and the virtual robot bind the traits
+//! of `docs/protocol.md`, drives the six joint servos and the gripper (`docs/servo-bus.md`), the
+//! LEDs and the user pins, and runs the kinematics. Everything here is a state machine polled
+//! with the time ([`Atom::poll`]); the board layer (`src/bin`) and the virtual robot bind the traits
 //! ([`protocol_core::BytePort`], [`AtomIo`]) to hardware or to a simulation.
 //!
 //! # Behaviour a client sees
 //! * **Replies.** Every request gets exactly one reply with its CMD byte, sent as soon as the
-//!   request's last byte is in (from cached state); only get servo data (0x53) waits for a servo
-//!   read (bounded by the retries below). Set commands answer `01` when accepted and `00` when
-//!   refused; a refusal changes nothing and, where `protocol.md` has a code, records it for
-//!   0x07 (1..6 joint limit, 32 unreachable pose, 33/34 linear move). Invalid frames (unknown
-//!   code, wrong length, value out of range) answer `00`.
+//!   request's last byte is in (from cached state); only get servo data (0x53), get PID (0x2D)
+//!   and backup / restore (0xEA / 0xEB) wait for servo reads (bounded by the retries below).
+//!   Set commands answer `01` when accepted and `00` when refused; a refusal changes nothing
+//!   and, where `protocol.md` has a code, records it for 0x07 (1..6 joint limit, 32 unreachable
+//!   pose, 33/34 a line, jog or arc). Invalid frames (unknown code, wrong length, value out of
+//!   range) answer `00`.
 //! * **State** (angles, coords, encoders, speeds, voltages, temperatures, faults) comes from
 //!   the servos: registers 40..=70 of every servo are read in turn (one READ each), about 225
 //!   rounds per second (bench `latency`). Coordinates are the forward kinematics of the present

@@ -20,7 +20,8 @@
 //! A reply garbled on the wire (the start of a frame heard but no valid frame, or a frame for
 //! another command) is lost for good: the Atom does not know. The Basic then sends the request again at once, instead of
 //! leaving the host to wait 0.5 s and resend it itself - unless repeating it could move the
-//! arm twice ([`is_repeatable`]: the incremental jogs 0x33 and 0x34).
+//! arm twice or act twice otherwise ([`is_repeatable`]: the incremental jogs 0x33 and 0x34, the
+//! next drag-teaching point 0xF3, move round 0xD4).
 
 use heapless::Vec;
 use protocol_core::command::cmd;

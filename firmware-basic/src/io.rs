@@ -1,5 +1,5 @@
 //! What the Basic's board gives the transponder: two user outputs, two user inputs, an optional
-//! ToF distance sensor and the three front buttons (`hardware.md`).
+//! ToF distance sensor and the three front buttons (`docs/boards.md`).
 
 use protocol_core::command::{BasicInputPin, BasicOutputPin};
 

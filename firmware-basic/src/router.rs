@@ -18,7 +18,7 @@
 //! client with `Basic::open_link` and closes it when the client leaves with
 //! `Basic::close_link`. At most [`MAX_HOST_LINKS`] links are open; `open_link` refuses the
 //! next with [`LinksFull`], and the transport then turns the client away (the TCP servers
-//! reset the connection at once, see `docs/protocol-notes-router.md`).
+//! close the connection at once, see `docs/protocol.md` section 16).
 //!
 //! The board's ports are lent to `Basic::poll` as one [`HostPorts`], which reaches each
 //! link's port by its id. Any single [`BytePort`] is a [`HostPorts`] whose only link is the

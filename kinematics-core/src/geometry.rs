@@ -1,4 +1,4 @@
-//! The arm's link geometry (standard DH, `kinematics.md`) and the forward chain of link
+//! The arm's link geometry (standard DH, `docs/kinematics.md`) and the forward chain of link
 //! transforms. The parameters live here and only here, so a calibrated set can replace them.
 
 use crate::JointAngles;

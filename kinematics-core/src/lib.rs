@@ -1,4 +1,4 @@
-//! Fixed-point kinematics of the myCobot 280 M5 (`kinematics.md`): forward and closed-form
+//! Fixed-point kinematics of the myCobot 280 M5 (`docs/kinematics.md`): forward and closed-form
 //! inverse kinematics of the flange for the vendor DH table, tool and world frames, joint
 //! limits as data, and straight-line Cartesian paths.
 //!
@@ -19,7 +19,7 @@
 //! # What callers get
 //!
 //! * [`Kinematics::forward`]: the end pose (tool in world, per [`Kinematics::set_tool`] and
-//!   [`Kinematics::set_world`]) of joint angles, RPY as in `kinematics.md` (at ry = +-90 deg,
+//!   [`Kinematics::set_world`]) of joint angles, RPY as in `docs/kinematics.md` (at ry = +-90 deg,
 //!   rz = 0).
 //! * [`Kinematics::inverse`]: all up to 8 closed-form branches, each joint wrapped by +-360 deg
 //!   into the [`JointLimits`], the best fit (exact, then up to 0.2 mm clamped, then traded at the

@@ -5,8 +5,8 @@ use crate::JointAngles;
 /// Centidegrees in a full turn.
 const TURN_CENTIDEG: i32 = 36_000;
 
-/// Per-joint limits in centidegrees (inclusive); `Default` = the current firmware limits of
-/// `kinematics.md` (J1 +-168, J2 +-140, J3 +-150, J4 +-150, J5 -155..+160, J6 +-180 deg).
+/// Per-joint limits in centidegrees (inclusive); `Default` = the factory range of
+/// `docs/kinematics.md` (J1 +-168, J2 +-140, J3 +-150, J4 +-150, J5 -155..+160, J6 +-180 deg).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct JointLimits {
     /// Lowest allowed angle of each joint, centidegrees.

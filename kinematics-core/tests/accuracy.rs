@@ -23,7 +23,7 @@ const LEN_PER_MM: f64 = 16_000.0;
 
 type Mat = [[f64; 4]; 4];
 
-/// The vendor DH table (d mm, a mm, alpha deg, theta offset deg), straight from kinematics.md.
+/// The vendor DH table (d mm, a mm, alpha deg, theta offset deg), as in docs/kinematics.md.
 const DH: [(f64, f64, f64, f64); 6] = [
     (131.22, 0.0, 90.0, 0.0),
     (0.0, -110.4, 0.0, -90.0),

@@ -1,4 +1,4 @@
-//! Feetech STS servo packets (`servo-bus.md`).
+//! Feetech STS servo packets (`docs/servo-bus.md`).
 //!
 //! ```text
 //! instruction:  FF FF ID LEN INSTR P1..Pn CHK      LEN = n + 2
@@ -62,7 +62,7 @@ pub mod fault {
     pub const OVERLOAD: u8 = 32;
 }
 
-/// Control-table addresses of the STS/SMS series (`servo-bus.md`).
+/// Control-table addresses of the STS/SMS series (`docs/servo-bus.md`).
 pub mod reg {
     /// Firmware major version (ro).
     pub const FIRMWARE_MAJOR: u8 = 0;

@@ -1,5 +1,5 @@
-//! Every self-consistent example frame of the seed manual
-//! (`/work/shared/seeds/000_f553feb70e90d320.txt`, section 3.3), with what it means to us.
+//! Every self-consistent example frame of the seed manual (the vendor's "Basic development
+//! guide", Chinese, V2021.01.27, section 3.3; `docs/protocol.md`), with what it means to us.
 //!
 //! Examples whose LEN does not match their byte count (0x22, 0x2A, 0x3C, 0x41, 0x50 request,
 //! 0x81/0x83 and their replies, 0x12/0x2B replies) are left out: no parser can agree with

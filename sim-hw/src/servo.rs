@@ -1,4 +1,4 @@
-//! A simulated Feetech STS servo (`servo-bus.md`): the control table, the instructions, a
+//! A simulated Feetech STS servo (`docs/servo-bus.md`): the control table, the instructions, a
 //! trapezoidal position motion and the faults a test can inject.
 //!
 //! The servo listens to every byte of the bus ([`SimServo::poll`]), obeys instructions for its
@@ -210,7 +210,8 @@ pub struct SimServo {
 
 impl SimServo {
     /// A servo with factory settings for `id`, its shaft at encoder position `position`.
-    /// The vendor PID is set per joint: id 4 gets 32/32/0, the others 10/0/1 (`servo-bus.md`).
+    /// The PID is set per joint: id 4 gets 32/32/0, the others 10/0/1 (`docs/servo-bus.md`,
+    /// which also gives the seed manual's different values).
     pub fn new(id: u8, position: u16) -> Self {
         let mut servo = Self {
             table: [0; reg::TABLE_SIZE],

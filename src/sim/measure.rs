@@ -16,7 +16,7 @@ pub struct FlangePose {
     pub rotation: Rotation,
 }
 
-/// DH alpha of each joint, degrees (`kinematics.md`).
+/// DH alpha of each joint, degrees (`docs/kinematics.md`).
 const ALPHA_DEG: [f64; 6] = [90.0, 0.0, 0.0, 90.0, -90.0, 0.0];
 
 /// The flange pose at joint angles `q_deg` (degrees, the protocol's joint angles).

@@ -265,7 +265,7 @@ mod tests {
         let snapshot = Snapshot::of(&robot);
         assert_eq!(snapshot.time_us, 50_000);
         assert_eq!(snapshot.angles, [Centideg(0); 6]);
-        // kinematics.md: the zero pose is (45.6, -63.4, 412.67) mm, (-90, 0, -90) deg.
+        // docs/kinematics.md: the zero pose is (45.6, -63.4, 412.67) mm, (-90, 0, -90) deg.
         assert_eq!(snapshot.coords, pose([456, -634, 4126, -9000, 0, -9000]));
         assert_eq!((snapshot.end, snapshot.tool), (EndType::Flange, None));
         assert!(snapshot.powered);

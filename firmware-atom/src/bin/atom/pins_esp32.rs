@@ -1,4 +1,4 @@
-//! The real Atom (ESP32-PICO-D4), as in `hardware.md`. GPIO 6..11, 16 and 17 belong to the
+//! The real Atom (ESP32-PICO-D4), as in `docs/boards.md`. GPIO 6..11, 16 and 17 belong to the
 //! embedded flash and are never taken.
 
 /// Moves the Atom's pins out of `$p` (esp-hal `Peripherals`).

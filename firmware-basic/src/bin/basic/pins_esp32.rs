@@ -1,4 +1,4 @@
-//! The real M5Stack Basic (ESP32), as in `hardware.md`.
+//! The real M5Stack Basic (ESP32), as in `docs/boards.md`.
 
 /// An output on a GPIO.
 pub type FixedOutput = esp_hal::gpio::Output<'static>;
