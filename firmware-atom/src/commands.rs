@@ -20,7 +20,7 @@ use crate::cartesian::for_client;
 use crate::config::{GRIPPER, JOINTS, SERVOS};
 use crate::error::AtomError;
 use crate::health::ServoHealth;
-use crate::io::{AtomIo, PinMode, is_output_pin};
+use crate::io::{AtomIo, PinMode, is_output_pin, mode_allowed};
 use crate::link::Link;
 use crate::motion::{JogDirection, Target, Way, angles_match};
 use crate::registers::{self, ServoAccess};
@@ -452,8 +452,7 @@ fn execute<I: AtomIo>(
                 WirePinMode::Output => PinMode::Output,
                 WirePinMode::InputPullUp => PinMode::InputPullUp,
             };
-            let allowed = mode != PinMode::Output || is_output_pin(pin.gpio());
-            done_if(allowed && io.set_pin_mode(pin.gpio(), mode))
+            done_if(mode_allowed(pin.gpio(), mode) && io.set_pin_mode(pin.gpio(), mode))
         }
         R::SetDigitalOutput { pin, high } => {
             done_if(is_output_pin(pin.gpio()) && io.write_pin(pin.gpio(), high))

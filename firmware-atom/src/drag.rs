@@ -113,7 +113,8 @@ impl DragRecorder {
             encoders: core::array::from_fn(|j| bank.health(j).map_or(Steps(0), |h| h.position)),
             speeds_steps_per_s: core::array::from_fn(|j| {
                 bank.health(j).map_or(0, |h| {
-                    // Replayable as is: set encoders drag takes 0..=6000 steps/s.
+                    // What the servo reports: 0 for a joint at rest. Set encoders drag refuses
+                    // 0 (the servo would race), so a replay through it gives such a joint a speed.
                     h.speed_steps_per_s.saturating_abs().min(MAX_DRAG_SPEED)
                 })
             }),

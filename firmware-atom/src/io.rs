@@ -14,6 +14,15 @@ pub fn is_output_pin(pin: u8) -> bool {
     OUTPUT_PINS.contains(&pin)
 }
 
+/// True if `pin` may be put in `mode` (0x60): the user pins in any mode; the button pin (GPIO39,
+/// input only and without internal pulls on the ESP32) only as a plain input.
+pub fn mode_allowed(pin: u8, mode: PinMode) -> bool {
+    match mode {
+        PinMode::Input => is_input_pin(pin),
+        PinMode::Output | PinMode::InputPullUp => is_output_pin(pin),
+    }
+}
+
 /// True if clients may read `pin`.
 pub fn is_input_pin(pin: u8) -> bool {
     INPUT_PINS.contains(&pin)
@@ -233,6 +242,20 @@ impl AtomIo for RecordingIo {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_button_pin_is_a_plain_input_and_the_user_pins_take_every_mode() {
+        assert!(mode_allowed(39, PinMode::Input));
+        assert!(
+            !mode_allowed(39, PinMode::InputPullUp),
+            "GPIO39 has no internal pull"
+        );
+        assert!(!mode_allowed(39, PinMode::Output));
+        for mode in [PinMode::Input, PinMode::Output, PinMode::InputPullUp] {
+            assert!(mode_allowed(22, mode));
+            assert!(!mode_allowed(25, mode));
+        }
+    }
 
     #[test]
     fn inputs_read_their_pulls_and_what_drives_them() {

@@ -53,7 +53,7 @@ class DragTeachingTest(RobotTestCase):
             6.0,
         )
         self.assertTrue(arrived, f"replay ended at {self.mc.get_encoders()}, recorded {last}")
-        # set_encoders_drag takes the recorded speeds as they are.
+        # set_encoders_drag refuses speed 0 (a joint at rest): give those a speed of their own.
         self.home()
         encoders, speeds = points[len(points) // 2]
         self.assertEqual(self.mc.set_encoders_drag(encoders, [max(s, 200) for s in speeds]), 1)

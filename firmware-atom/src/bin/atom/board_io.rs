@@ -188,6 +188,10 @@ fn make_input(gpio: &mut Flex<'_>, pull: Pull) {
 
 impl AtomIo for BoardIo<'_> {
     fn set_pin_mode(&mut self, pin: u8, mode: PinMode) -> bool {
+        if pin == BUTTON_PIN {
+            // The button's pin is always a plain input (the library allows nothing else).
+            return mode == PinMode::Input;
+        }
         let Some((user, pwm_on)) = self.user_pin(pin) else {
             return false;
         };
