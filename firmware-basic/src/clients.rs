@@ -31,14 +31,16 @@ use crate::router::{HostPorts, LinkId, MAX_HOST_LINKS};
 /// Network clients served at once: every host link but the USB one.
 pub const MAX_NETWORK_CLIENTS: usize = MAX_HOST_LINKS - 1;
 
-/// Bytes from one client waiting for the Basic. pymycobot sends one request (at most 68
-/// bytes) and waits for its reply; 1 KiB holds a long pipelined burst.
-pub const CLIENT_RX_BYTES: usize = 1024;
+/// Bytes from one client waiting for the Basic (more wait in the socket). pymycobot sends one
+/// request (at most 68 bytes) and waits for its reply; the Basic takes 64 bytes per link per
+/// poll, so 512 bytes are several polls' worth. Seven clients' buffers both ways are 7 KiB, on
+/// the board's loop stack next to the `Basic`.
+pub const CLIENT_RX_BYTES: usize = 512;
 
-/// Bytes for one client waiting for its socket: a reply of any size (the 0xB1 text is the
-/// longest) leaves in one piece, and in transparent mode 1 KiB is 10 ms of a busy bus. A client
-/// that does not read loses what does not fit (it never stalls the Basic).
-pub const CLIENT_TX_BYTES: usize = 1024;
+/// Bytes for one client waiting for its socket: a reply of any size (the 0xB1 text, 113
+/// bytes, is the longest) leaves in one piece, and the socket takes them every loop pass. A
+/// client that does not read loses what does not fit (it never stalls the Basic).
+pub const CLIENT_TX_BYTES: usize = 512;
 
 /// One network client, from [`NetworkClients::connect`]. Never reused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
