@@ -54,6 +54,14 @@ fn start(flash: &Path, pty: &Path, tcp: Option<&str>) -> Launched {
     launch(&args)
 }
 
+/// An empty directory for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 fn stop(mut robot: Launched) {
     let exit = robot.stop_with(Signal::SIGTERM);
     assert!(exit.is_some_and(|s| s.success()), "{exit:?}");
@@ -61,9 +69,7 @@ fn stop(mut robot: Launched) {
 
 #[test]
 fn the_settings_survive_a_restart_and_the_tcp_server_follows_the_stored_port() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("wifi-restart");
-    let _ = fs::remove_dir_all(&dir);
-    fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("wifi-restart");
     let flash = dir.join("state/basic-flash.bin");
     let pty = dir.join("mycobot");
     let first_port = free_port(20_000 + (std::process::id() % 5_000) as u16);
@@ -123,9 +129,7 @@ fn the_settings_survive_a_restart_and_the_tcp_server_follows_the_stored_port() {
 
 #[test]
 fn a_flash_file_that_is_not_one_is_a_clear_error() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("wifi-bad-flash");
-    let _ = fs::remove_dir_all(&dir);
-    fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("wifi-bad-flash");
     let flash = dir.join("notes.txt");
     fs::write(&flash, "not a flash image").unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_open-mycobot"))

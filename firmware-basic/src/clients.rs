@@ -283,23 +283,10 @@ impl<U: BytePort> HostPorts for ClientPorts<'_, U> {
 mod tests {
     use super::*;
     use crate::{BasicConfig, NullIo};
-
-    /// A port that never receives and takes everything: the USB link and the bus, idle.
-    #[derive(Default)]
-    struct Quiet;
-
-    impl BytePort for Quiet {
-        fn read_byte(&mut self) -> Option<u8> {
-            None
-        }
-        fn write(&mut self, _: &[u8]) {}
-        fn tx_idle(&self) -> bool {
-            true
-        }
-    }
+    use protocol_core::NullPort;
 
     fn poll(clients: &mut NetworkClients, basic: &mut Basic, now_us: u64) {
-        clients.poll_basic(basic, now_us, &mut Quiet, &mut Quiet, &mut NullIo);
+        clients.poll_basic(basic, now_us, &mut NullPort, &mut NullPort, &mut NullIo);
     }
 
     fn take(clients: &mut NetworkClients, client: NetClient) -> std::vec::Vec<u8> {
@@ -353,7 +340,7 @@ mod tests {
             CLIENT_RX_BYTES
         );
         assert_eq!(clients.room(a), 0);
-        let mut usb = Quiet;
+        let mut usb = NullPort;
         let mut ports = clients.ports(&mut usb);
         let link = LinkId::from_index(1).unwrap();
         ports.write_to(link, &[1; CLIENT_TX_BYTES + 10]);
