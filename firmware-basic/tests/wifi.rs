@@ -251,3 +251,33 @@ fn without_a_store_the_basic_has_no_wifi() {
     assert!(rig.basic.wifi().is_none());
     assert_eq!(rig.basic.wifi_status(0), None);
 }
+
+#[test]
+fn the_network_going_down_does_not_disturb_the_usb_link() {
+    let mut rig = rig();
+    rig.atom_delay_ns = 300_000;
+    let a = rig.connect().unwrap();
+    let b = rig.connect().unwrap();
+    // Both network clients are busy, one of them mid-frame, and the USB client waits for the
+    // Atom's reply when Wi-Fi is lost (the board closes every network link at once).
+    rig.client(a).send(&frame(0x20, &[]));
+    rig.client(b).send(&[0xFE, 0xFE, 0x04]);
+    rig.host.send(&frame(0x20, &[]));
+    rig.run_us(700);
+    rig.disconnect(a);
+    rig.disconnect(b);
+    assert!(
+        rig.run_until_host_has(17, 20_000),
+        "{:02x?}",
+        rig.host.received()
+    );
+    assert_eq!(rig.host.frames()[0].cmd(), 0x20);
+    // And the USB link goes on as before.
+    rig.host.send(&frame(0xC1, &[]));
+    rig.run_us(3_000);
+    assert_eq!(rig.host.frames().last().unwrap(), &frame_of(0xC1, &[10]));
+}
+
+fn frame_of(cmd: u8, data: &[u8]) -> protocol_core::Frame {
+    protocol_core::Frame::new(cmd, data).unwrap()
+}
