@@ -5,7 +5,9 @@
 //! what the robot sent back to its clients. The pseudo-terminal is the robot's serial line;
 //! each TCP client is a network client of the Basic with a host link of its own, so every
 //! client gets its own answers (the Basic's router serves them in turn and refuses clients
-//! beyond its limit: their connection is closed at once). While clients are talking the tick
+//! beyond its limit: their connection is closed at once). With
+//! [`RealtimeDriver::follow_server_port`] the TCP server moves to the port the Basic's Wi-Fi
+//! settings name, as the board's sockets do. While clients are talking the tick
 //! is [`ACTIVE_TICK`], so a reply leaves at most that long after the simulated 115200 baud
 //! wire finished sending it (the wire itself takes 87 us per byte, 1.5 ms for a `get_angles`
 //! reply); when the line has been quiet for [`ACTIVE_SPELL`] the loop ticks at [`IDLE_TICK`]

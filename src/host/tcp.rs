@@ -2,10 +2,12 @@
 //! ways, no extra framing. pymycobot's `MyCobot280Socket` talks to it unchanged.
 //!
 //! Each connection is one client with a link of its own on the robot (see
-//! [`super::realtime`]): the server only moves bytes. It asks whether to admit each new
-//! connection; one turned away is closed at once, so the client reads end-of-file
-//! (`MyCobot280Socket` raises `BrokenPipeError` on its first command). A client that
-//! disconnects or fails is dropped without disturbing the robot or the others.
+//! [`super::realtime`]): the server only moves bytes. Who is let in, the client limit, each
+//! client's buffers and what a leaving client closes are the simulated Basic's, through the
+//! firmware library's `firmware_basic::NetworkClients`, the code the board's sockets use. The
+//! server asks whether to admit each new connection; one turned away is closed at once, so the
+//! client reads end-of-file (`MyCobot280Socket` raises `BrokenPipeError` on its first command).
+//! A client that disconnects or fails is dropped without disturbing the robot or the others.
 
 use std::io::{self, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
