@@ -20,8 +20,9 @@ pub const BASIC_FLASH_BYTES: usize = 6 * 4096;
 /// The simulated flash.
 pub type BasicFlash = MemFlash<BASIC_FLASH_BYTES>;
 
-/// The simulated Basic's settings store: its flash, in RAM or kept in a file. See the
-/// [module doc](self).
+/// The simulated Basic's settings store: its flash, in RAM or kept in a file whose raw image
+/// is rewritten whole (through a temporary file renamed over it) after each change; a write
+/// that fails undoes the change and is reported as a flash failure.
 #[derive(Clone, Debug)]
 pub struct BasicFlashStore {
     store: FlashWifiStore<BasicFlash>,
