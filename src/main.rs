@@ -3,16 +3,18 @@
 //! until Ctrl-C or SIGTERM.
 
 use std::io::Write;
+use std::net::Ipv4Addr;
 use std::process::ExitCode;
 use std::sync::Arc;
 
 use clap::Parser;
-use open_mycobot::host::cli::Cli;
+use firmware_basic::wifi::WifiConfig;
+use open_mycobot::host::cli::{Cli, default_basic_flash};
 use open_mycobot::host::pty::PseudoTerminal;
 use open_mycobot::host::pty_link::PtyLink;
 use open_mycobot::host::realtime::{RealtimeDriver, ServedRobot, stop_on_signals};
 use open_mycobot::host::tcp::TcpServer;
-use open_mycobot::sim::{RobotConfig, VirtualRobot};
+use open_mycobot::sim::{BasicFlashStore, RobotConfig, VirtualRobot};
 use open_mycobot::web::{self, Snapshot, StateBoard, WebServer};
 
 fn main() -> ExitCode {
@@ -31,9 +33,21 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
     let stop = stop_on_signals()?;
     let pty =
         PseudoTerminal::open().map_err(|e| format!("cannot create a pseudo-terminal: {e}"))?;
+    let flash_file = cli.basic_flash.clone().or_else(default_basic_flash);
+    let mut flash = match &flash_file {
+        Some(path) => BasicFlashStore::open(path)
+            .map_err(|e| format!("cannot read the Basic's flash {}: {e}", path.display()))?,
+        None => BasicFlashStore::in_memory(),
+    };
+    // `--tcp` alone: where the Basic's stored settings say, and wherever they move.
+    let stored_port = WifiConfig::load(&mut flash).settings().port();
+    let follow = cli.tcp.is_some_and(|addr| addr.is_none());
     let tcp = cli
         .tcp
-        .map(|addr| TcpServer::bind(addr).map_err(|e| format!("cannot listen on {addr}: {e}")))
+        .map(|addr| {
+            let addr = addr.unwrap_or_else(|| (Ipv4Addr::LOCALHOST, stored_port).into());
+            TcpServer::bind(addr).map_err(|e| format!("cannot listen on {addr}: {e}"))
+        })
         .transpose()?;
     let link = cli
         .pty_link
@@ -68,6 +82,10 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(link) = &link {
         writeln!(out, "pty link {}", link.path().display())?;
     }
+    match &flash_file {
+        Some(path) => writeln!(out, "basic flash {}", path.display())?,
+        None => writeln!(out, "basic flash in memory (no $XDG_STATE_HOME or $HOME)")?,
+    }
     if let Some(tcp) = &tcp {
         writeln!(out, "tcp on {}", tcp.local_addr()?)?;
     }
@@ -83,10 +101,16 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
     drop(out);
 
     let robot = ServedRobot {
-        robot: VirtualRobot::new(RobotConfig::default()),
+        robot: VirtualRobot::new(RobotConfig::default()).with_basic_flash(flash),
         link: cli.port.into(),
     };
     let mut driver = RealtimeDriver::new(robot, pty, tcp);
+    if follow {
+        driver = driver.follow_server_port(Ipv4Addr::LOCALHOST.into(), |moved| match moved {
+            Ok(addr) => println!("tcp on {addr} (set_server_port)"),
+            Err(e) => eprintln!("open-mycobot: the Basic's new server port cannot be had: {e}"),
+        });
+    }
     if view.is_some() {
         driver = driver.observe_every(web::PUBLISH_PERIOD, move |served: &ServedRobot| {
             board.publish(Snapshot::of(&served.robot));

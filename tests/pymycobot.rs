@@ -33,6 +33,10 @@ impl Robot {
     fn start() -> Robot {
         let link = std::env::temp_dir().join(format!("open-mycobot-e2e-{}", std::process::id()));
         let link_arg = link.to_str().expect("temp dir path is UTF-8");
+        // The Basic's flash (Wi-Fi settings the suite changes) in a scratch file, erased.
+        let flash = Path::new(env!("CARGO_TARGET_TMPDIR")).join("e2e-basic-flash.bin");
+        let _ = fs::remove_file(&flash);
+        let flash_arg = flash.to_str().expect("target dir path is UTF-8");
         // The view on too (nobody watches it): the suite runs with the simulation publishing.
         let launched = launch(&[
             "--pty-link",
@@ -41,6 +45,8 @@ impl Robot {
             "127.0.0.1:0",
             "--web",
             "127.0.0.1:0",
+            "--basic-flash",
+            flash_arg,
         ]);
         let tcp = launched
             .banner_value("tcp on ")

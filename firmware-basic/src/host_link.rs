@@ -24,6 +24,12 @@ pub const HOST_READ_BUDGET: usize = 64;
 /// of garbage only ever delays its own client's next request, so the gap is generous.
 pub const NETWORK_FRAME_GAP_US: u64 = 20_000;
 
+/// Silence after which the bare 0xB0 text from a network client is complete, in microseconds
+/// (on the serial line it is the frame gap, 2 ms). pymycobot writes the text in one `send` and
+/// reads the answer for only 50 ms, so the gap is short: a segment split by the network arrives
+/// within it as a rule, and the answer still leaves well inside pymycobot's read.
+pub const NETWORK_TEXT_GAP_US: u64 = 5_000;
+
 /// How long pymycobot's socket client waits for a reply before it sends again, in microseconds
 /// (`MyCobot280Socket`: 0.3 s per try; the serial client waits 0.5 s).
 pub const NETWORK_REPLY_DEADLINE_US: u64 = 300_000;
@@ -45,6 +51,15 @@ impl LinkKind {
         match self {
             Self::Serial => timing::HOST_FRAME_GAP_US,
             Self::Network => NETWORK_FRAME_GAP_US,
+        }
+    }
+
+    /// Silence after which the bare 0xB0 text (`crate::wifi::SetTextCapture`) is complete, in
+    /// microseconds: 2 ms on the serial line, [`NETWORK_TEXT_GAP_US`] on a network link.
+    pub const fn text_gap_us(self) -> u64 {
+        match self {
+            Self::Serial => timing::HOST_FRAME_GAP_US,
+            Self::Network => NETWORK_TEXT_GAP_US,
         }
     }
 

@@ -3,6 +3,8 @@
 
 use protocol_core::command::{BasicInputPin, BasicOutputPin};
 
+use crate::wifi::WifiStore;
+
 /// User output pins a client may drive with 0xA0 (GPIO5 drives the suction-pump valve).
 pub const OUTPUT_PINS: [u8; 2] = BasicOutputPin::ALLOWED;
 /// User input pins a client may read with 0xA1 (input-only GPIOs).
@@ -35,6 +37,14 @@ pub trait BasicIo {
 
     /// Which front buttons are pressed now.
     fn buttons(&mut self) -> Buttons;
+
+    /// Where the Wi-Fi settings are kept (the board's flash; a file in the virtual robot).
+    /// `None` (the default): the board has no Wi-Fi, and 0xB0..0xB2 answer as such. Asked at
+    /// boot (the settings are loaded then) and for every Wi-Fi command; a board with Wi-Fi
+    /// always lends the same store.
+    fn wifi_store(&mut self) -> Option<&mut dyn WifiStore> {
+        None
+    }
 }
 
 /// A board with nothing attached: outputs refuse, inputs and the sensor read nothing, no button

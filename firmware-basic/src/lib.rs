@@ -14,8 +14,15 @@
 //!   and each reply goes to the client that asked.
 //! * [`local`]: the commands the Basic answers itself (0xA0, 0xA1, 0xB0..0xB2, 0xC0..0xC3), at
 //!   once, to the client that asked, even while the Atom is silent or a flood fills a queue.
-//!   The Basic has no Wi-Fi: 0xB0/0xB2 are refused with `00`, 0xB1 reports empty credentials
-//!   in the text form pymycobot parses.
+//! * [`wifi`]: the Wi-Fi settings (0xB0..0xB2, kept in the flash store the board lends through
+//!   [`BasicIo::wifi_store`]) and the station machine; [`Basic::wifi_mut`] is how the board's
+//!   network layer drives the station. 0xB0's bare text is caught per link (a
+//!   [`wifi::SetTextCapture`] before that link's framer). A settings change is written to flash
+//!   when the bus is quiet (a flash erase stalls the CPU), at most [`WIFI_WRITE_WAIT_US`] after
+//!   it arrived. A board that lends no store has no Wi-Fi: 0xB0/0xB2 are refused with `00`,
+//!   0xB1 reports empty credentials in the text form pymycobot parses.
+//! * [`clients`]: the network clients (TCP) as the board's sockets and the virtual robot's
+//!   streams both use them: a link each, bounded buffers both ways, the client limit.
 //! * [`forwarder`]: everything else goes onto the bus, one request at a time, into a quiet
 //!   wire, echo checked (heard or not: [`EchoMode::Auto`] finds out on the first send),
 //!   collisions and garbled replies retried; only the reply with the request's CMD comes back,
@@ -53,6 +60,7 @@
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 
+pub mod clients;
 pub mod config;
 pub mod forwarder;
 pub mod host_link;
@@ -64,6 +72,7 @@ mod supervisor;
 pub mod transparent;
 pub mod wifi;
 
+pub use clients::{NetClient, NetworkClients};
 pub use config::{BasicConfig, ConfigError, EchoMode};
 pub use host_link::LinkKind;
 pub use io::{BasicIo, Buttons, NullIo};
@@ -71,17 +80,25 @@ pub use router::{HostPorts, LinkId, LinksFull, MAX_HOST_LINKS};
 pub use status::{AtomLink, BasicError, BasicStatus, TransponderMode};
 
 use forwarder::{Event, Forwarder};
+use heapless::Deque;
 use host_link::{HOST_READ_BUDGET, HostFrames};
 use protocol_core::command::{Reply, cmd, is_basic_local};
 use protocol_core::listener::{Listener, ListenerConfig};
 use protocol_core::{BytePort, Frame};
-use router::Router;
+use router::{Client, Router};
 use supervisor::Supervisor;
 use transparent::{Intercepted, Transparent};
+use wifi::{SetTextEnd, Wifi, WifiStatus};
 
 /// Most bus bytes taken per poll: a poll stays short, and 256 bytes is 2.5 ms of bus time,
 /// far more than arrives between two polls of a board's loop.
 pub const BUS_READ_BUDGET: usize = 256;
+
+/// Longest a Wi-Fi settings change waits for a quiet bus before it is written to flash anyway,
+/// in microseconds. The bus is quiet again within an exchange with the Atom (about 1 ms); only
+/// a silent Atom keeps it busy longer (up to [`BasicConfig::reply_timeout_us`]), and the
+/// client's answer must still come within pymycobot's 50 ms read.
+pub const WIFI_WRITE_WAIT_US: u64 = 20_000;
 
 /// How the Basic hears the bus: host frames (the Atom's replies) and every byte that is not its
 /// own echo (transparent mode passes them on, and they show a reply that began garbled);
@@ -105,6 +122,26 @@ enum Mode {
     Transparent { owner: LinkId },
 }
 
+/// A Wi-Fi settings change waiting for a quiet bus.
+#[derive(Debug)]
+struct WifiWrite {
+    /// Who asked: the answer goes to this client only.
+    client: Client,
+    /// When it arrived, microseconds.
+    since_us: u64,
+    /// What to do.
+    work: WifiWork,
+}
+
+/// A change of the Wi-Fi settings.
+#[derive(Debug)]
+enum WifiWork {
+    /// 0xB2, or 0xB0 with the text framed.
+    Frame(Frame),
+    /// The end of a link's bare 0xB0 text.
+    Text(SetTextEnd),
+}
+
 /// The Basic's transponder: one per board, polled forever.
 #[derive(Debug)]
 pub struct Basic {
@@ -118,6 +155,11 @@ pub struct Basic {
     supervisor: Supervisor,
     /// The first poll (the Basic's boot) has happened.
     booted: bool,
+    /// The Wi-Fi, on a board that lends a settings store (from the first poll on).
+    wifi: Option<Wifi>,
+    /// Wi-Fi settings changes waiting for a quiet bus (at most one per link: a client waits
+    /// for its answer).
+    wifi_writes: Deque<WifiWrite, MAX_HOST_LINKS>,
 }
 
 impl Basic {
@@ -134,7 +176,27 @@ impl Basic {
             transparent: Transparent::default(),
             supervisor: Supervisor::new(&config),
             booted: false,
+            wifi: None,
+            wifi_writes: Deque::new(),
         }
+    }
+
+    /// The Wi-Fi (settings and station), on a board that lends a settings store
+    /// ([`BasicIo::wifi_store`]), from the first poll on.
+    pub fn wifi(&self) -> Option<&Wifi> {
+        self.wifi.as_ref()
+    }
+
+    /// The Wi-Fi, for the board's network layer: it feeds the station the driver's events
+    /// ([`Wifi::on_event`]) and carries out its actions ([`Wifi::poll`]).
+    pub fn wifi_mut(&mut self) -> Option<&mut Wifi> {
+        self.wifi.as_mut()
+    }
+
+    /// What the LCD shows about Wi-Fi, with `clients` network clients connected; `None` on a
+    /// board without Wi-Fi.
+    pub fn wifi_status(&self, clients: u8) -> Option<WifiStatus> {
+        self.wifi.as_ref().map(|w| w.status(clients))
     }
 
     /// Opens a host link for a new client of `kind` (a TCP connection: [`LinkKind::Network`]),
@@ -176,9 +238,11 @@ impl Basic {
             // Whatever the wire was doing before we booted, give it a quiet time first.
             self.bus.assume_busy_until(now_us);
             self.supervisor.boot(now_us, &self.config);
+            self.wifi = io.wifi_store().map(|store| Wifi::start(now_us, store));
         }
         self.read_bus(now_us, bus);
         self.read_hosts(now_us, hosts, io);
+        self.write_wifi_settings(now_us, io);
         let buttons = io.buttons();
         match self.mode {
             Mode::Transparent { owner } if self.forwarder.idle() => {
@@ -199,7 +263,8 @@ impl Basic {
                 let internal = self
                     .supervisor
                     .next_internal(now_us, &self.config, buttons, idle);
-                if mode == Mode::Framed && self.forwarder.idle() {
+                // A settings change waiting for the quiet bus goes first.
+                if mode == Mode::Framed && self.forwarder.idle() && self.wifi_writes.is_empty() {
                     let (supervisor, router) = (&mut self.supervisor, &mut self.router);
                     let next = internal.or_else(|| {
                         // An expired request has no reply to give.
@@ -285,6 +350,9 @@ impl Basic {
             let quiet_us = self.router.quiet_for_us(now_us, link);
             self.transparent.host_quiet(quiet_us);
         } else {
+            if let Some(end) = self.router.poll_capture(now_us, link) {
+                self.queue_wifi_write(now_us, link, WifiWork::Text(end));
+            }
             let mut frames = HostFrames::new();
             self.router.check_gap(now_us, link, &mut frames);
             for frame in frames.drain(..) {
@@ -324,17 +392,20 @@ impl Basic {
             }
         }
         self.supervisor.on_host_request(code);
-        let mode = self.status().mode;
-        if let Some(answer) = local::answer(&frame, io, self.config.version_x10, mode) {
-            let sent = match &answer.reply {
-                local::Reply::Frame(reply) => self.router.send_frame(link, reply),
-                local::Reply::Raw(bytes) => self.router.send_bytes(link, bytes),
-            };
-            if !sent {
-                self.supervisor.error(BasicError::HostOverflow);
-            }
-            if let Some(error) = answer.error {
-                self.supervisor.error(error);
+        if self.wifi.is_some() && wifi::writes_settings(&frame) {
+            self.queue_wifi_write(now_us, link, WifiWork::Frame(frame));
+            return;
+        }
+        let cx = local::Context {
+            version_x10: self.config.version_x10,
+            mode: self.status().mode,
+            wifi: self.wifi.as_mut(),
+            now_us,
+        };
+        if let Some(answer) = local::answer(&frame, io, cx) {
+            self.send_answer(link, &answer);
+            if answer.capture_text {
+                self.router.start_capture(now_us, link);
             }
             if answer.new_mode == Some(TransponderMode::Transparent) && self.mode == Mode::Framed {
                 self.enter_transparent(link);
@@ -346,6 +417,74 @@ impl Basic {
         };
         if self.router.push(client, frame, now_us).is_err() {
             self.supervisor.error(BasicError::QueueFull { cmd: code });
+        }
+    }
+
+    /// Queues the answer to one of the Basic's own commands for `link`, noting what went wrong.
+    fn send_answer(&mut self, link: LinkId, answer: &local::Answer) {
+        let sent = match &answer.reply {
+            local::Reply::Frame(reply) => self.router.send_frame(link, reply),
+            local::Reply::Text(bytes) => self.router.send_bytes(link, bytes),
+        };
+        if !sent {
+            self.supervisor.error(BasicError::HostOverflow);
+        }
+        if let Some(error) = answer.error {
+            self.supervisor.error(error);
+        }
+    }
+
+    /// Keeps a Wi-Fi settings change from `link` until the bus is quiet.
+    fn queue_wifi_write(&mut self, now_us: u64, link: LinkId, work: WifiWork) {
+        let Some(client) = self.router.client(link) else {
+            return;
+        };
+        let code = match &work {
+            WifiWork::Frame(frame) => frame.cmd(),
+            WifiWork::Text(_) => cmd::SET_SSID_PWD,
+        };
+        let write = WifiWrite {
+            client,
+            since_us: now_us,
+            work,
+        };
+        if self.wifi_writes.push_back(write).is_err() {
+            // A link has at most one change waiting unless its client does not wait for its
+            // answers: refuse that one.
+            self.send_frame(link, &Reply::Byte(0).to_frame(code));
+        }
+    }
+
+    /// Writes the waiting Wi-Fi settings changes once no request is on the bus (or they have
+    /// waited [`WIFI_WRITE_WAIT_US`]), and answers each client that asked.
+    fn write_wifi_settings<I: BasicIo>(&mut self, now_us: u64, io: &mut I) {
+        while let Some(front) = self.wifi_writes.front() {
+            let waited = now_us.saturating_sub(front.since_us);
+            if !self.forwarder.idle() && waited < WIFI_WRITE_WAIT_US {
+                return;
+            }
+            let Some(write) = self.wifi_writes.pop_front() else {
+                return;
+            };
+            let answer = match write.work {
+                WifiWork::Frame(frame) => {
+                    let cx = local::Context {
+                        version_x10: self.config.version_x10,
+                        mode: self.status().mode,
+                        wifi: self.wifi.as_mut(),
+                        now_us,
+                    };
+                    local::answer(&frame, io, cx)
+                }
+                WifiWork::Text(end) => local::answer_set_text(end, io, self.wifi.as_mut(), now_us),
+            };
+            // The client may have gone meanwhile (its link closed or reused): then nobody is
+            // answered, but the change stands.
+            if let Some(answer) = answer
+                && self.router.client(write.client.link) == Some(write.client)
+            {
+                self.send_answer(write.client.link, &answer);
+            }
         }
     }
 

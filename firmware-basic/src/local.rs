@@ -5,25 +5,30 @@
 //! |---|---|
 //! | 0xA0 set output (pin 2 or 5, level 0/1) | `01` done, `00` refused (bad pin or level) |
 //! | 0xA1 get input (pin 35 or 36) | pin, level; level `FF` (pymycobot: 255) for a bad pin |
-//! | 0xB0 set Wi-Fi SSID/password, 0xB2 set server port | `00`: the Basic has no Wi-Fi |
-//! | 0xB1 get Wi-Fi SSID/password | the text `ssid:  password: ` (pymycobot: `('', '')`) |
+//! | 0xB0 set Wi-Fi SSID/password, 0xB2 set server port | `01` stored, `00` refused or the flash write failed ([`crate::wifi`]); `00` on a board without Wi-Fi |
+//! | 0xB1 get Wi-Fi SSID/password | the text `ssid: <ssid> password: <password>`; `ssid:  password: ` (pymycobot: `('', '')`) without Wi-Fi |
 //! | 0xC0 ToF distance | int16 mm; -1 without a sensor |
 //! | 0xC1 Basic version | version x 10 |
 //! | 0xC2 set transponder mode (0 framed, 1 transparent) | `01`, or `00` for another mode |
 //! | 0xC3 get transponder mode | mode |
 //!
 //! 0xB1 answers raw text, not a frame, because that is what pymycobot reads: it decodes the
-//! bytes as UTF-8 and splits them at spaces (a frame would make it raise). A request that
+//! bytes as UTF-8 and splits them at spaces (a frame would make it raise). The Wi-Fi commands
+//! go to the Basic's [`Wifi`] with the flash store the board lends ([`BasicIo::wifi_store`]); a
+//! board that lends none has no Wi-Fi. A request that
 //! `protocol_core::command::Request::parse` rejects (wrong length, bad level or mode) is
 //! refused with `00`.
 
+use heapless::Vec;
 use protocol_core::Frame;
 use protocol_core::command::{CommandError, Reply as ReplyData, Request, cmd, is_basic_local};
 
 use crate::io::BasicIo;
 use crate::status::{BasicError, TransponderMode};
+use crate::wifi::{MAX_GET_TEXT, SetTextEnd, Wifi, WifiAnswer, WifiReply};
 
-/// What 0xB1 answers: no network configured, in the text form pymycobot parses.
+/// What 0xB1 answers on a board without Wi-Fi: no network configured, in the text form
+/// pymycobot parses.
 pub const NO_WIFI_TEXT: &[u8] = b"ssid:  password: ";
 
 /// Level byte of 0xA1 for a pin that cannot be read: neither 0 nor 1 (pymycobot returns 255).
@@ -39,6 +44,9 @@ pub(crate) struct Answer {
     pub(crate) new_mode: Option<TransponderMode>,
     /// What went wrong, for the display.
     pub(crate) error: Option<BasicError>,
+    /// The request was 0xB0's announcing frame, acknowledged: the link's next bytes are the
+    /// bare text (a `SetTextCapture`).
+    pub(crate) capture_text: bool,
 }
 
 /// A reply for the host.
@@ -46,8 +54,8 @@ pub(crate) struct Answer {
 pub(crate) enum Reply {
     /// A reply frame.
     Frame(Frame),
-    /// Raw bytes (0xB1).
-    Raw(&'static [u8]),
+    /// Bare text (0xB1).
+    Text(Vec<u8, MAX_GET_TEXT>),
 }
 
 impl Answer {
@@ -56,6 +64,19 @@ impl Answer {
             reply: Reply::Frame(data.to_frame(cmd)),
             new_mode: None,
             error: None,
+            capture_text: false,
+        }
+    }
+
+    fn from_wifi(answer: WifiAnswer) -> Self {
+        Self {
+            reply: match answer.reply {
+                WifiReply::Frame(frame) => Reply::Frame(frame),
+                WifiReply::Text(text) => Reply::Text(text),
+            },
+            new_mode: None,
+            error: answer.error.map(BasicError::Wifi),
+            capture_text: answer.capture_text,
         }
     }
 
@@ -70,17 +91,31 @@ impl Answer {
     }
 }
 
+/// The Basic's state its own commands read or change.
+pub(crate) struct Context<'a> {
+    /// Version x 10 (0xC1).
+    pub(crate) version_x10: u8,
+    /// The transponder mode (0xC3).
+    pub(crate) mode: TransponderMode,
+    /// The Wi-Fi (0xB0..0xB2), if the board has it.
+    pub(crate) wifi: Option<&'a mut Wifi>,
+    /// The time, microseconds.
+    pub(crate) now_us: u64,
+}
+
 /// Answers `frame` if it is one of the Basic's own commands; `None` if it is for the Atom.
-pub(crate) fn answer<I: BasicIo>(
-    frame: &Frame,
-    io: &mut I,
-    version_x10: u8,
-    mode: TransponderMode,
-) -> Option<Answer> {
+pub(crate) fn answer<I: BasicIo>(frame: &Frame, io: &mut I, cx: Context<'_>) -> Option<Answer> {
     let code = frame.cmd();
     if !is_basic_local(code) {
         return None;
     }
+    if let Some(wifi) = cx.wifi
+        && let Some(store) = io.wifi_store()
+        && let Some(answer) = wifi.answer(cx.now_us, frame, store)
+    {
+        return Some(Answer::from_wifi(answer));
+    }
+    let (version_x10, mode) = (cx.version_x10, cx.mode);
     let answer = match Request::parse(frame) {
         Ok(Request::SetBasicOutput { pin, high }) => {
             Answer::status(code, io.set_output(pin.gpio(), high))
@@ -95,11 +130,17 @@ pub(crate) fn answer<I: BasicIo>(
             ),
             None => pin_unreadable(code, pin.gpio()),
         },
-        Ok(Request::GetSsidPwd) => Answer {
-            reply: Reply::Raw(NO_WIFI_TEXT),
-            new_mode: None,
-            error: None,
-        },
+        Ok(Request::GetSsidPwd) => {
+            let mut text = Vec::new();
+            // Cannot fail: the text is shorter than any 0xB1 answer may be.
+            let _ = text.extend_from_slice(NO_WIFI_TEXT);
+            Answer {
+                reply: Reply::Text(text),
+                new_mode: None,
+                error: None,
+                capture_text: false,
+            }
+        }
         Ok(Request::GetTofDistance) => {
             let mm = io
                 .tof_distance_mm()
@@ -122,6 +163,20 @@ pub(crate) fn answer<I: BasicIo>(
         _ => Answer::status(code, false),
     };
     Some(answer)
+}
+
+/// Answers the end of a link's 0xB0 text capture at `now_us`: `01` stored, `00` refused or the
+/// flash failed; `None` if nothing is due (no text came, or the board has no Wi-Fi any more).
+pub(crate) fn answer_set_text<I: BasicIo>(
+    end: SetTextEnd,
+    io: &mut I,
+    wifi: Option<&mut Wifi>,
+    now_us: u64,
+) -> Option<Answer> {
+    let store = io.wifi_store()?;
+    wifi?
+        .answer_set_text(now_us, end, store)
+        .map(Answer::from_wifi)
 }
 
 /// 0xA1's answer for a pin that cannot be read: the pin, level `FF`.
@@ -162,18 +217,19 @@ mod tests {
     }
 
     fn ask(io: &mut FakeIo, cmd: u8, data: &[u8]) -> Option<Answer> {
-        answer(
-            &Frame::new(cmd, data).unwrap(),
-            io,
-            12,
-            TransponderMode::Framed,
-        )
+        let cx = Context {
+            version_x10: 12,
+            mode: TransponderMode::Framed,
+            wifi: None,
+            now_us: 0,
+        };
+        answer(&Frame::new(cmd, data).unwrap(), io, cx)
     }
 
     fn reply_bytes(answer: &Answer) -> std::vec::Vec<u8> {
         match &answer.reply {
             Reply::Frame(f) => f.to_bytes().to_vec(),
-            Reply::Raw(bytes) => bytes.to_vec(),
+            Reply::Text(bytes) => bytes.to_vec(),
         }
     }
 

@@ -29,6 +29,7 @@ use protocol_core::{BytePort, Frame};
 
 use crate::forwarder::{Origin, Request};
 use crate::host_link::{HostFrames, HostLink, LinkKind};
+use crate::wifi::{Captured, SetTextCapture, SetTextEnd};
 
 /// Most host links open at once, the USB link included: the USB serial and seven network
 /// clients. An ESP32's network stack serves about ten sockets (one listens); every link costs
@@ -144,6 +145,9 @@ struct Slot {
     session: u16,
     link: HostLink,
     waiting: Deque<Waiting, LINK_QUEUE_DEPTH>,
+    /// The bare 0xB0 text this link's client sends after the announcing frame: its bytes go
+    /// here instead of to the framer until the capture ends.
+    capture: Option<SetTextCapture>,
 }
 
 impl Slot {
@@ -153,6 +157,7 @@ impl Slot {
             session: 0,
             link: HostLink::new(kind),
             waiting: Deque::new(),
+            capture: None,
         }
     }
 
@@ -242,7 +247,9 @@ impl Router {
     }
 
     /// Takes one byte from `link`'s port at `now_us`; the frames it completes go into
-    /// `frames`. `None` if nothing has arrived (or the link is closed).
+    /// `frames`. `None` if nothing has arrived (or the link is closed). While the link captures
+    /// a 0xB0 text ([`Self::start_capture`]) the byte goes to the capture instead, unless it
+    /// cannot begin the text (then the capture is over and the framer hears it).
     pub(crate) fn read_byte<H: HostPorts>(
         &mut self,
         now_us: u64,
@@ -250,10 +257,34 @@ impl Router {
         link: LinkId,
         frames: &mut HostFrames,
     ) -> Option<u8> {
-        let host_link = self.host_link(link)?;
+        let slot = self.slots.get_mut(link.index()).filter(|s| s.open)?;
         let byte = ports.read_from(link)?;
-        host_link.hear(now_us, byte, frames);
+        if let Some(capture) = slot.capture.as_mut() {
+            match capture.push(now_us, byte) {
+                Captured::Taken => return Some(byte),
+                Captured::NotText => slot.capture = None,
+            }
+        }
+        slot.link.hear(now_us, byte, frames);
         Some(byte)
+    }
+
+    /// `link`'s next bytes are the bare 0xB0 text (its announcing frame was answered at
+    /// `now_us`): they go to a [`SetTextCapture`] until the link has been quiet for its
+    /// [`LinkKind::text_gap_us`].
+    pub(crate) fn start_capture(&mut self, now_us: u64, link: LinkId) {
+        if let Some(slot) = self.slots.get_mut(link.index()).filter(|s| s.open) {
+            slot.capture = Some(SetTextCapture::new(now_us, slot.link.kind().text_gap_us()));
+        }
+    }
+
+    /// How `link`'s 0xB0 text capture ended, once it has (at `now_us`); the link is framed
+    /// again then.
+    pub(crate) fn poll_capture(&mut self, now_us: u64, link: LinkId) -> Option<SetTextEnd> {
+        let slot = self.slots.get_mut(link.index()).filter(|s| s.open)?;
+        let end = slot.capture.as_mut()?.poll(now_us)?;
+        slot.capture = None;
+        Some(end)
     }
 
     /// Lets time pass on `link`: a partial frame cut short by the link's gap is dropped, and
@@ -387,13 +418,16 @@ impl Router {
         }
     }
 
-    /// Hands each open link's queued bytes to its port once the port's transmitter is idle.
+    /// Hands each open link's queued bytes to its port, a chunk at a time for as long as the
+    /// port's transmitter is idle (a UART is busy after one chunk; a network client's buffer
+    /// takes a whole reply, so it leaves in one piece: pymycobot's socket client takes one
+    /// `recv` as the whole answer).
     pub(crate) fn flush<H: HostPorts>(&mut self, ports: &mut H) {
         for (index, slot) in self.slots.iter_mut().enumerate() {
             let Some(link) = LinkId::from_index(index).filter(|_| slot.open) else {
                 continue;
             };
-            if let Some(chunk) = slot.link.next_chunk(ports.tx_idle_on(link)) {
+            while let Some(chunk) = slot.link.next_chunk(ports.tx_idle_on(link)) {
                 ports.write_to(link, &chunk);
             }
         }

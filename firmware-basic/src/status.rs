@@ -2,6 +2,8 @@
 
 pub use protocol_core::command::TransponderMode;
 
+use crate::wifi::WifiError;
+
 /// Whether the Atom answers.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum AtomLink {
@@ -47,6 +49,9 @@ pub enum BasicError {
     /// Bytes for the host were dropped because the host link could not keep up (in
     /// transparent mode a busy bus outpaces the 115200 host link; the oldest bytes go).
     HostOverflow,
+    /// A Wi-Fi command was refused or its flash write failed (the client got `00`; nothing
+    /// changed).
+    Wifi(WifiError),
 }
 
 /// What the Basic shows on its LCD.

@@ -18,11 +18,20 @@ pub struct Cli {
     #[arg(long, value_name = "PATH")]
     pub pty_link: Option<PathBuf>,
 
-    /// Also serve the host protocol over TCP on ADDR:PORT (raw frames, like the Basic's Wi-Fi
-    /// server), e.g. `--tcp 127.0.0.1:9000` then `MyCobot280Socket("127.0.0.1", 9000)`.
-    /// Port 0 picks a free port; the address used is printed.
-    #[arg(long, value_name = "ADDR:PORT")]
-    pub tcp: Option<SocketAddr>,
+    /// Also serve the host protocol over TCP (raw frames, like the Basic's Wi-Fi server), e.g.
+    /// `--tcp` then `MyCobot280Socket("127.0.0.1", 9000)`. Alone, on 127.0.0.1 at the port in
+    /// the Basic's Wi-Fi settings (9000 until `set_server_port` changes it; the server then
+    /// moves there, as the board does). With ADDR:PORT, there and nowhere else (port 0 picks a
+    /// free port). The address used is printed.
+    #[arg(long, value_name = "ADDR:PORT", num_args = 0..=1)]
+    #[allow(clippy::option_option, reason = "absent, alone, or with an address")]
+    pub tcp: Option<Option<SocketAddr>>,
+
+    /// The file the simulated Basic keeps its flash in (its Wi-Fi settings, which
+    /// `set_ssid_pwd` and `set_server_port` change), so they survive a restart. Default:
+    /// `$XDG_STATE_HOME/open-mycobot/basic-flash.bin` (`~/.local/state/...` without it).
+    #[arg(long, value_name = "PATH")]
+    pub basic_flash: Option<PathBuf>,
 
     /// Which board's USB serial the clients talk to: the Basic (as with the real arm's USB
     /// cable) or the Atom's own USB port (a direct link to the arm's controller).
@@ -37,6 +46,20 @@ pub struct Cli {
     /// Do not serve the 3D view.
     #[arg(long)]
     pub no_web: bool,
+}
+
+/// Where the simulated Basic's flash is kept without `--basic-flash`: `open-mycobot/
+/// basic-flash.bin` in `$XDG_STATE_HOME`, or in `$HOME/.local/state`; `None` if neither is set.
+pub fn default_basic_flash() -> Option<PathBuf> {
+    let state = std::env::var_os("XDG_STATE_HOME")
+        .filter(|dir| !dir.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| {
+            std::env::var_os("HOME")
+                .filter(|dir| !dir.is_empty())
+                .map(|home| PathBuf::from(home).join(".local/state"))
+        })?;
+    Some(state.join("open-mycobot/basic-flash.bin"))
 }
 
 /// A USB serial port of the virtual arm.
@@ -82,10 +105,15 @@ mod tests {
         ])
         .unwrap();
         assert_eq!(cli.pty_link, Some(PathBuf::from("/tmp/mycobot")));
-        assert_eq!(cli.tcp, Some("127.0.0.1:9000".parse().unwrap()));
+        assert_eq!(cli.tcp, Some(Some("127.0.0.1:9000".parse().unwrap())));
+        let alone = Cli::try_parse_from(["open-mycobot", "--tcp", "--no-web"]).unwrap();
+        assert_eq!(alone.tcp, Some(None));
+        assert!(alone.no_web);
+        let flash = Cli::try_parse_from(["open-mycobot", "--basic-flash", "/tmp/f.bin"]).unwrap();
+        assert_eq!(flash.basic_flash, Some(PathBuf::from("/tmp/f.bin")));
 
         let bare = Cli::try_parse_from(["open-mycobot"]).unwrap();
-        assert!(bare.pty_link.is_none() && bare.tcp.is_none());
+        assert!(bare.pty_link.is_none() && bare.tcp.is_none() && bare.basic_flash.is_none());
         assert_eq!(HostLink::from(bare.port), HostLink::Basic);
         let atom = Cli::try_parse_from(["open-mycobot", "--port", "atom-usb"]).unwrap();
         assert_eq!(HostLink::from(atom.port), HostLink::AtomUsb);

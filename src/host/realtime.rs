@@ -5,13 +5,16 @@
 //! what the robot sent back to its clients. The pseudo-terminal is the robot's serial line;
 //! each TCP client is a network client of the Basic with a host link of its own, so every
 //! client gets its own answers (the Basic's router serves them in turn and refuses clients
-//! beyond its limit: their connection is closed at once). While clients are talking the tick
+//! beyond its limit: their connection is closed at once). With
+//! [`RealtimeDriver::follow_server_port`] the TCP server moves to the port the Basic's Wi-Fi
+//! settings name, as the board's sockets do. While clients are talking the tick
 //! is [`ACTIVE_TICK`], so a reply leaves at most that long after the simulated 115200 baud
 //! wire finished sending it (the wire itself takes 87 us per byte, 1.5 ms for a `get_angles`
 //! reply); when the line has been quiet for [`ACTIVE_SPELL`] the loop ticks at [`IDLE_TICK`]
 //! and costs almost no CPU.
 
 use std::io;
+use std::net::{IpAddr, SocketAddr};
 use std::os::fd::BorrowedFd;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -70,6 +73,11 @@ pub trait RealtimeRobot {
     fn link_write(&mut self, _link: HostLink, _bytes: &[u8]) {}
     /// Appends what the robot sent to the network client on `link` so far.
     fn link_read(&mut self, _link: HostLink, _out: &mut Vec<u8>) {}
+    /// The TCP port the robot's Basic serves its network clients on (its Wi-Fi settings, which
+    /// 0xB2 `set_server_port` changes); `None` without one.
+    fn server_port(&self) -> Option<u16> {
+        None
+    }
 }
 
 /// The virtual robot served on one of its USB ports.
@@ -108,6 +116,9 @@ impl RealtimeRobot for ServedRobot {
     fn link_read(&mut self, link: HostLink, out: &mut Vec<u8>) {
         self.robot.link_read(link, out);
     }
+    fn server_port(&self) -> Option<u16> {
+        Some(self.robot.basic()?.wifi()?.settings().port())
+    }
 }
 
 /// Something that looks at the robot now and then from inside the loop (the web view takes its
@@ -129,11 +140,21 @@ impl<R> Observer<R> {
     }
 }
 
+/// Where the TCP server listens when it follows the Basic's server port, and who is told when
+/// it moves.
+struct FollowPort {
+    ip: IpAddr,
+    /// The port last tried and not had (not tried again until the Basic's port changes).
+    refused: Option<u16>,
+    moved: Box<dyn FnMut(io::Result<SocketAddr>) + Send>,
+}
+
 /// The real-time loop: a robot, its pseudo-terminal and optionally a TCP server.
 pub struct RealtimeDriver<R> {
     robot: R,
     pty: PseudoTerminal,
     tcp: Option<TcpServer>,
+    follow: Option<FollowPort>,
     /// The robot's link for each TCP client.
     tcp_links: Vec<(ClientId, HostLink)>,
     pacer: LinePacer,
@@ -147,6 +168,7 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             robot,
             pty,
             tcp,
+            follow: None,
             tcp_links: Vec::new(),
             pacer: LinePacer::new(HOST_BAUD, WINDOW_BYTES),
             observer: None,
@@ -165,6 +187,23 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             period,
             next: Instant::now(),
             look: Box::new(look),
+        });
+        self
+    }
+
+    /// Makes the TCP server listen on `ip` at the Basic's server port
+    /// ([`RealtimeRobot::server_port`]) and move when a client changes it (0xB2), like the
+    /// board: new connections go to the new port, the clients connected stay. `moved` is told
+    /// the new address, or why the port could not be had (the server then stays where it is).
+    pub fn follow_server_port(
+        mut self,
+        ip: IpAddr,
+        moved: impl FnMut(io::Result<SocketAddr>) + Send + 'static,
+    ) -> Self {
+        self.follow = Some(FollowPort {
+            ip,
+            refused: None,
+            moved: Box::new(moved),
         });
         self
     }
@@ -200,11 +239,38 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
 
             let had_input = self.forward_client_input(&mut input)?;
             let had_output = self.deliver(&mut output)?;
+            self.follow_port();
             if had_input || had_output {
                 last_traffic = Some(Instant::now());
             }
         }
         Ok(self.robot)
+    }
+
+    /// Moves the TCP server to the Basic's server port if it follows it and the port changed.
+    fn follow_port(&mut self) {
+        let (Some(follow), Some(tcp), Some(port)) = (
+            self.follow.as_mut(),
+            self.tcp.as_mut(),
+            self.robot.server_port(),
+        ) else {
+            return;
+        };
+        let now = tcp.local_addr().map(|a| a.port()).ok();
+        if now == Some(port) || follow.refused == Some(port) {
+            return;
+        }
+        let addr = SocketAddr::new(follow.ip, port);
+        match tcp.listen_on(addr) {
+            Ok(()) => {
+                follow.refused = None;
+                (follow.moved)(Ok(addr));
+            }
+            Err(e) => {
+                follow.refused = Some(port);
+                (follow.moved)(Err(e));
+            }
+        }
     }
 
     /// Sleeps until a client sends something or `tick` passes. A client whose link cannot take

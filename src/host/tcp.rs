@@ -2,10 +2,12 @@
 //! ways, no extra framing. pymycobot's `MyCobot280Socket` talks to it unchanged.
 //!
 //! Each connection is one client with a link of its own on the robot (see
-//! [`super::realtime`]): the server only moves bytes. It asks whether to admit each new
-//! connection; one turned away is closed at once, so the client reads end-of-file
-//! (`MyCobot280Socket` raises `BrokenPipeError` on its first command). A client that
-//! disconnects or fails is dropped without disturbing the robot or the others.
+//! [`super::realtime`]): the server only moves bytes. Who is let in, the client limit, each
+//! client's buffers and what a leaving client closes are the simulated Basic's, through the
+//! firmware library's `firmware_basic::NetworkClients`, the code the board's sockets use. The
+//! server asks whether to admit each new connection; one turned away is closed at once, so the
+//! client reads end-of-file (`MyCobot280Socket` raises `BrokenPipeError` on its first command).
+//! A client that disconnects or fails is dropped without disturbing the robot or the others.
 
 use std::io::{self, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -40,6 +42,16 @@ impl TcpServer {
             clients: Vec::new(),
             next_id: 0,
         })
+    }
+
+    /// Listens on `addr` from now on instead (the Basic's port was changed): connections not yet
+    /// accepted on the old address are refused, the clients already connected stay. On error
+    /// the old address is kept.
+    pub fn listen_on(&mut self, addr: SocketAddr) -> io::Result<()> {
+        let listener = TcpListener::bind(addr)?;
+        listener.set_nonblocking(true)?;
+        self.listener = listener;
+        Ok(())
     }
 
     /// The address actually listened on.
@@ -249,5 +261,34 @@ mod tests {
         let mut buf = [0u8; 16];
         let n = second.read(&mut buf).unwrap();
         assert_eq!(&buf[..n], &[0xFE, 0xFE, 0x03, 0x10, 0x01, 0xFA]);
+    }
+
+    #[test]
+    fn moving_to_another_port_keeps_the_clients_connected() {
+        let mut server = localhost_server();
+        let mut first = TcpStream::connect(server.local_addr().unwrap()).unwrap();
+        first.write_all(&[1]).unwrap();
+        let got = pump(&mut server, 1, usize::MAX);
+        let first_id = got[0].0;
+        let old = server.local_addr().unwrap();
+        server.listen_on("127.0.0.1:0".parse().unwrap()).unwrap();
+        let new = server.local_addr().unwrap();
+        assert_ne!(old.port(), new.port());
+        let mut second = TcpStream::connect(new).unwrap();
+        second.write_all(&[2]).unwrap();
+        let got = pump(&mut server, 1, usize::MAX);
+        assert_eq!(got[0].1, [2]);
+        assert_eq!(server.client_count(), 2);
+        assert!(server.send(first_id, &[9]));
+        first
+            .set_read_timeout(Some(Duration::from_secs(2)))
+            .unwrap();
+        let mut buf = [0u8; 1];
+        first.read_exact(&mut buf).unwrap();
+        assert_eq!(buf, [9]);
+        // A port that cannot be had: the server stays where it is.
+        let taken = TcpListener::bind("127.0.0.1:0").unwrap();
+        assert!(server.listen_on(taken.local_addr().unwrap()).is_err());
+        assert_eq!(server.local_addr().unwrap(), new);
     }
 }

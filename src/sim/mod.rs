@@ -33,11 +33,13 @@
 //! assert_eq!(robot.servo(1).map(|s| s.present_position()), Some(2048));
 //! ```
 
+mod basic_flash;
 pub mod measure;
 mod robot;
 
 pub use sim_hw::{servo, wire};
 
+pub use basic_flash::{BASIC_FLASH_BYTES, BasicFlash, BasicFlashStore};
 pub use robot::{
     AskError, HostLink, NET_BUFFER_BYTES, NetClient, POLL_PERIOD_NS, RobotConfig, SERVO_IDS,
     SimBasicIo, VirtualRobot,

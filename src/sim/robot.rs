@@ -1,15 +1,16 @@
 //! The whole virtual arm under virtual time: the real Basic and Atom firmware libraries, the
 //! shared bus, seven simulated servos, and the USB serial links of both boards.
 
-use std::collections::VecDeque;
-
 use firmware_atom::{Atom, AtomConfig, RecordingIo};
-use firmware_basic::{Basic, BasicConfig, BasicIo, Buttons, HostPorts, LinkId, LinkKind};
+use firmware_basic::clients::CLIENT_RX_BYTES;
+use firmware_basic::wifi::WifiStore;
+use firmware_basic::{Basic, BasicConfig, BasicIo, Buttons, NetworkClients};
 use protocol_core::command::{Reply, ReplyError, Request};
 use protocol_core::timing::{HOST_BAUD, HOST_REPLY_DEADLINE_US};
 use protocol_core::units::{Centideg, Steps};
-use protocol_core::{BytePort, Frame, FrameDecoder};
+use protocol_core::{Frame, FrameDecoder};
 
+use super::basic_flash::BasicFlashStore;
 use super::servo::SimServo;
 use super::wire::{Bus, HeardByte, SerialLine, SerialPort, StationId};
 use sim_hw::ServoChain;
@@ -107,6 +108,34 @@ impl BasicIo for SimBasicIo {
     }
 }
 
+/// What the simulated Basic's firmware is lent as its board: the pins and its flash.
+struct SimBoardIo<'a> {
+    io: &'a mut SimBasicIo,
+    flash: &'a mut BasicFlashStore,
+}
+
+impl BasicIo for SimBoardIo<'_> {
+    fn set_output(&mut self, pin: u8, high: bool) -> bool {
+        self.io.set_output(pin, high)
+    }
+
+    fn read_input(&mut self, pin: u8) -> Option<bool> {
+        self.io.read_input(pin)
+    }
+
+    fn tof_distance_mm(&mut self) -> Option<u16> {
+        self.io.tof_distance_mm()
+    }
+
+    fn buttons(&mut self) -> Buttons {
+        self.io.buttons()
+    }
+
+    fn wifi_store(&mut self) -> Option<&mut dyn WifiStore> {
+        Some(self.flash)
+    }
+}
+
 /// When a board's main loop runs next (see [`RobotConfig::atom_loop_us`]).
 #[derive(Clone, Copy, Debug)]
 struct BoardLoop {
@@ -174,51 +203,9 @@ impl UsbLink {
 }
 
 /// Bytes a network client may have on their way to the Basic at once; a client that sends more
-/// waits (TCP flow control: [`VirtualRobot::link_room`]).
-pub const NET_BUFFER_BYTES: usize = 4096;
-
-/// A network client of the Basic: one of its host links, with no wire time (what one side
-/// writes, the other can read at once).
-#[derive(Clone, Debug)]
-struct NetLink {
-    client: NetClient,
-    link: LinkId,
-    to_board: VecDeque<u8>,
-    to_host: VecDeque<u8>,
-}
-
-/// The Basic's host links as its firmware sees them: the USB serial and the network clients.
-struct BasicPorts<'a> {
-    usb: SerialPort<'a>,
-    net: &'a mut [NetLink],
-}
-
-impl BasicPorts<'_> {
-    fn net(&mut self, link: LinkId) -> Option<&mut NetLink> {
-        self.net.iter_mut().find(|n| n.link == link)
-    }
-}
-
-impl HostPorts for BasicPorts<'_> {
-    fn read_from(&mut self, link: LinkId) -> Option<u8> {
-        if link == LinkId::USB {
-            return self.usb.read_byte();
-        }
-        self.net(link)?.to_board.pop_front()
-    }
-
-    fn write_to(&mut self, link: LinkId, bytes: &[u8]) {
-        if link == LinkId::USB {
-            self.usb.write(bytes);
-        } else if let Some(net) = self.net(link) {
-            net.to_host.extend(bytes);
-        }
-    }
-
-    fn tx_idle_on(&self, link: LinkId) -> bool {
-        link != LinkId::USB || self.usb.tx_idle()
-    }
-}
+/// waits (TCP flow control: [`VirtualRobot::link_room`]). The Basic library's own buffer
+/// (`firmware_basic::clients`), as on the board.
+pub const NET_BUFFER_BYTES: usize = CLIENT_RX_BYTES;
 
 struct BasicBoard {
     firmware: Basic,
@@ -228,15 +215,12 @@ struct BasicBoard {
     boot_ns: u64,
     station: StationId,
     usb: UsbLink,
-    /// The network clients connected now.
-    net: Vec<NetLink>,
+    /// The network clients connected now: the Basic library's own client handling, with no
+    /// wire time (what one side writes, the other can read at once).
+    clients: NetworkClients,
     io: SimBasicIo,
-}
-
-impl BasicBoard {
-    fn net_mut(&mut self, client: NetClient) -> Option<&mut NetLink> {
-        self.net.iter_mut().find(|n| n.client == client)
-    }
+    /// Where its Wi-Fi settings live.
+    flash: BasicFlashStore,
 }
 
 /// Why [`VirtualRobot::ask`] got no usable answer.
@@ -267,8 +251,7 @@ pub enum HostLink {
 
 /// One network client of the Basic, from [`VirtualRobot::connect`]; never reused, so a client
 /// that has gone (or lost its link when the Basic restarted) reaches nobody.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct NetClient(u64);
+pub use firmware_basic::NetClient;
 
 /// The virtual myCobot 280 M5. See the [simulation overview](crate::sim).
 ///
@@ -290,8 +273,6 @@ pub struct VirtualRobot {
     heard: Vec<HeardByte>,
     noise_station: StationId,
     next_poll_ns: u64,
-    /// The id of the next network client.
-    next_client: u64,
 }
 
 impl VirtualRobot {
@@ -306,8 +287,9 @@ impl VirtualRobot {
             boot_ns: 0,
             station: bus.attach(config.basic_hears_echo),
             usb: UsbLink::new(),
-            net: Vec::new(),
+            clients: NetworkClients::new(),
             io: SimBasicIo::default(),
+            flash: BasicFlashStore::in_memory(),
         });
         let atom_station = bus.attach(config.atom_hears_echo);
         let mut servos = ServoChain::new();
@@ -331,8 +313,22 @@ impl VirtualRobot {
             heard: Vec::new(),
             noise_station,
             next_poll_ns: 0,
-            next_client: 0,
         }
+    }
+
+    /// This robot with its Basic's flash (its Wi-Fi settings) in `flash`, e.g. kept in a file
+    /// ([`BasicFlashStore::open`]); by default it is an erased flash in RAM. The Basic loads its
+    /// settings when it boots: call this before the robot runs (or reset the Basic after).
+    pub fn with_basic_flash(mut self, flash: BasicFlashStore) -> Self {
+        if let Some(basic) = self.basic.as_mut() {
+            basic.flash = flash;
+        }
+        self
+    }
+
+    /// The Basic's flash, to make it fail or look at it; `None` without a Basic.
+    pub fn basic_flash_mut(&mut self) -> Option<&mut BasicFlashStore> {
+        self.basic.as_mut().map(|b| &mut b.flash)
     }
 
     /// Virtual time since power-up, in microseconds.
@@ -372,9 +368,8 @@ impl VirtualRobot {
         let now = self.now_ns;
         if let Some(usb) = self.usb_mut(link) {
             usb.to_board.send(now, bytes);
-        } else if let Some(net) = self.net_mut(link) {
-            let room = NET_BUFFER_BYTES.saturating_sub(net.to_board.len());
-            net.to_board.extend(bytes.iter().take(room).copied());
+        } else if let Some((basic, client)) = self.net_mut(link) {
+            basic.clients.receive(client, bytes);
         }
     }
 
@@ -382,11 +377,7 @@ impl VirtualRobot {
     /// it), a network link at most [`NET_BUFFER_BYTES`] waiting for the Basic.
     pub fn link_room(&self, link: HostLink) -> usize {
         match link {
-            HostLink::Network(client) => self
-                .basic
-                .as_ref()
-                .and_then(|b| b.net.iter().find(|n| n.client == client))
-                .map_or(0, |n| NET_BUFFER_BYTES.saturating_sub(n.to_board.len())),
+            HostLink::Network(client) => self.basic.as_ref().map_or(0, |b| b.clients.room(client)),
             HostLink::Basic | HostLink::AtomUsb => usize::MAX,
         }
     }
@@ -395,8 +386,15 @@ impl VirtualRobot {
     pub fn link_read(&mut self, link: HostLink, out: &mut Vec<u8>) {
         if let Some(usb) = self.usb_mut(link) {
             usb.to_host.receive_all(out);
-        } else if let Some(net) = self.net_mut(link) {
-            out.extend(net.to_host.drain(..));
+        } else if let Some((basic, client)) = self.net_mut(link) {
+            let mut chunk = [0u8; 256];
+            loop {
+                let n = basic.clients.transmit(client, &mut chunk);
+                let Some(bytes) = chunk.get(..n).filter(|b| !b.is_empty()) else {
+                    break;
+                };
+                out.extend_from_slice(bytes);
+            }
         }
     }
 
@@ -405,7 +403,9 @@ impl VirtualRobot {
         if let Some(usb) = self.usb_mut(link) {
             return usb.to_host.receive();
         }
-        self.net_mut(link)?.to_host.pop_front()
+        let (basic, client) = self.net_mut(link)?;
+        let mut byte = [0u8; 1];
+        (basic.clients.transmit(client, &mut byte) == 1).then_some(byte[0])
     }
 
     fn usb_mut(&mut self, link: HostLink) -> Option<&mut UsbLink> {
@@ -416,9 +416,10 @@ impl VirtualRobot {
         }
     }
 
-    fn net_mut(&mut self, link: HostLink) -> Option<&mut NetLink> {
+    /// The Basic and the network client `link` is, if it is one.
+    fn net_mut(&mut self, link: HostLink) -> Option<(&mut BasicBoard, NetClient)> {
         match link {
-            HostLink::Network(client) => self.basic.as_mut()?.net_mut(client),
+            HostLink::Network(client) => Some((self.basic.as_mut()?, client)),
             HostLink::Basic | HostLink::AtomUsb => None,
         }
     }
@@ -429,15 +430,7 @@ impl VirtualRobot {
     /// included) or the robot has no Basic.
     pub fn connect(&mut self) -> Option<HostLink> {
         let basic = self.basic.as_mut()?;
-        let link = basic.firmware.open_link(LinkKind::Network).ok()?;
-        let client = NetClient(self.next_client);
-        self.next_client += 1;
-        basic.net.push(NetLink {
-            client,
-            link,
-            to_board: VecDeque::new(),
-            to_host: VecDeque::new(),
-        });
+        let client = basic.clients.connect(&mut basic.firmware)?;
         Some(HostLink::Network(client))
     }
 
@@ -446,10 +439,7 @@ impl VirtualRobot {
         let (HostLink::Network(client), Some(basic)) = (link, self.basic.as_mut()) else {
             return;
         };
-        if let Some(index) = basic.net.iter().position(|n| n.client == client) {
-            let gone = basic.net.swap_remove(index);
-            basic.firmware.close_link(gone.link);
-        }
+        basic.clients.disconnect(&mut basic.firmware, client);
     }
 
     /// True while `link` reaches a board: always for the USB ports of the boards there are,
@@ -461,7 +451,7 @@ impl VirtualRobot {
             HostLink::Network(client) => self
                 .basic
                 .as_ref()
-                .is_some_and(|b| b.net.iter().any(|n| n.client == client)),
+                .is_some_and(|b| b.clients.is_connected(client)),
         }
     }
 
@@ -482,7 +472,7 @@ impl VirtualRobot {
             basic.firmware = Basic::new(basic.config);
             basic.boot_ns = self.now_ns;
             basic.usb = UsbLink::new();
-            basic.net.clear();
+            basic.clients.clear();
             self.bus.reset_station(basic.station);
         }
     }
@@ -551,14 +541,15 @@ impl VirtualRobot {
             && basic.main_loop.runs_at(now_ns)
             && let Some(mut bus) = self.bus.port(basic.station)
         {
-            let mut hosts = BasicPorts {
-                usb: basic.usb.board_port(now_ns),
-                net: &mut basic.net,
+            let mut usb = basic.usb.board_port(now_ns);
+            let mut io = SimBoardIo {
+                io: &mut basic.io,
+                flash: &mut basic.flash,
             };
             let basic_us = (now_ns - basic.boot_ns) / 1_000;
             basic
-                .firmware
-                .poll(basic_us, &mut hosts, &mut bus, &mut basic.io);
+                .clients
+                .poll_basic(&mut basic.firmware, basic_us, &mut usb, &mut bus, &mut io);
         }
         if self.atom_loop.runs_at(now_ns)
             && let Some(mut bus) = self.bus.port(self.atom_station)

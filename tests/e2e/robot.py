@@ -6,7 +6,7 @@ The robot is started by tests/pymycobot.rs (or by hand: `cargo run --release -- 
 /tmp/mycobot`) and found through the environment:
 
 * MYCOBOT_PORT   the serial device or symlink (default /tmp/mycobot)
-* MYCOBOT_TCP    host:port of the TCP server, for test_link.py's TCP test (skipped when unset)
+* MYCOBOT_TCP    host:port of the TCP server, for the TCP tests (skipped when unset)
 * MYCOBOT_FRESH  1 if the robot was started just for this run (tests/pymycobot.rs sets it)
 
 On first contact the suite notes the robot's start-up state, then resets what the tests rely
@@ -16,6 +16,7 @@ looks fresh or MYCOBOT_FRESH says it must be.
 
 import math
 import os
+import socket
 import struct
 import time
 import unittest
@@ -117,6 +118,19 @@ def _near(angles, expected):
         and len(angles) == len(expected)
         and all(abs(a - e) <= ANGLE_TOL for a, e in zip(angles, expected))
     )
+
+
+def tcp_address():
+    """(host, port) of the robot's TCP server, from MYCOBOT_TCP."""
+    host, port = os.environ["MYCOBOT_TCP"].rsplit(":", 1)
+    return host, int(port)
+
+
+def raw_client(timeout=1.0):
+    """A plain TCP connection to the robot, reads timing out after `timeout` s."""
+    sock = socket.create_connection(tcp_address())
+    sock.settimeout(timeout)
+    return sock
 
 
 def frame(cmd, *data):

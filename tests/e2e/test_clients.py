@@ -12,7 +12,7 @@ import unittest
 
 from pymycobot import MyCobot280Socket
 
-from robot import RobotTestCase
+from robot import RobotTestCase, raw_client, tcp_address
 
 # Network clients the Basic serves at once: firmware_basic::MAX_HOST_LINKS (8) minus the USB link.
 MAX_NETWORK_CLIENTS = 7
@@ -24,17 +24,6 @@ POSE = [20, -40, 60, -80, 30, 0]
 
 def frame(cmd, *data):
     return bytes([0xFE, 0xFE, len(data) + 2, cmd, *data, 0xFA])
-
-
-def tcp_address():
-    host, port = os.environ["MYCOBOT_TCP"].rsplit(":", 1)
-    return host, int(port)
-
-
-def raw_client(timeout=1.0):
-    sock = socket.create_connection(tcp_address())
-    sock.settimeout(timeout)
-    return sock
 
 
 def read_frame(sock):

@@ -26,7 +26,9 @@ pub mod config;
 pub mod connection;
 pub mod store;
 
-pub use config::{Credentials, SetTextCapture, SetTextEnd, SettingsError, WifiSettings};
+pub use config::{
+    Captured, Credentials, MAX_GET_TEXT, SetTextCapture, SetTextEnd, SettingsError, WifiSettings,
+};
 pub use connection::{Action, Failure, JoinFailure, LinkEvent, Station, StationState};
 pub use store::{ChangeError, Changed, FlashWifiStore, LoadError, WifiConfig, WifiStore};
 
@@ -37,7 +39,7 @@ use heapless::{String, Vec};
 use protocol_core::Frame;
 use protocol_core::command::{Reply, cmd};
 
-use config::{MAX_GET_TEXT, MAX_SSID_LEN};
+use config::MAX_SSID_LEN;
 
 /// The reply to a Wi-Fi command.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -235,6 +237,18 @@ impl Wifi {
             last_failure: self.station.last_failure(),
             settings_unreadable: self.config.load_error().is_some(),
         }
+    }
+}
+
+/// True for a Wi-Fi command that may write the settings to flash: 0xB0 with its text framed,
+/// 0xB2. (0xB0's announcing frame and 0xB1 only read; the bare text after the announcing frame
+/// writes too, see [`Wifi::answer_set_text`].) The Basic runs these when the bus is quiet: a
+/// flash erase stalls the CPU for tens of milliseconds.
+pub fn writes_settings(frame: &Frame) -> bool {
+    match frame.cmd() {
+        cmd::SET_SSID_PWD => !frame.data().is_empty(),
+        cmd::SET_SERVER_PORT => true,
+        _ => false,
     }
 }
 

@@ -11,9 +11,11 @@ pub mod clients;
 
 use std::collections::VecDeque;
 
+use firmware_basic::wifi::{FlashWifiStore, WifiStore};
 use firmware_basic::{
     Basic, BasicConfig, BasicIo, Buttons, HostPorts, LinkId, LinkKind, LinksFull, MAX_HOST_LINKS,
 };
+use flash_store::MemFlash;
 use protocol_core::listener::{Heard, Listener, ListenerConfig};
 use protocol_core::{BytePort, Frame, FrameDecoder, timing};
 use sim_hw::{Bus, HeardByte, StationId};
@@ -288,6 +290,16 @@ pub struct MemIo {
     pub tof_mm: Option<u16>,
     /// Buttons pressed now.
     pub buttons: Buttons,
+    /// The Wi-Fi settings' flash (`None`: a board without Wi-Fi).
+    pub wifi: Option<WifiFlash>,
+}
+
+/// The Wi-Fi settings' store in the tests: 24 KiB of RAM flash, like the board's `nvs` range.
+pub type WifiFlash = FlashWifiStore<MemFlash<{ 6 * 4096 }>>;
+
+/// An erased Wi-Fi settings flash.
+pub fn wifi_flash() -> WifiFlash {
+    FlashWifiStore::new(MemFlash::new(), 0..6 * 4096)
 }
 
 impl BasicIo for MemIo {
@@ -310,6 +322,10 @@ impl BasicIo for MemIo {
 
     fn buttons(&mut self) -> Buttons {
         self.buttons
+    }
+
+    fn wifi_store(&mut self) -> Option<&mut dyn WifiStore> {
+        self.wifi.as_mut().map(|s| s as &mut dyn WifiStore)
     }
 }
 

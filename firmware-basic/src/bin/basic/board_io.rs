@@ -1,7 +1,10 @@
-//! [`BasicIo`] on the chip: the two user outputs, the two user inputs and the front buttons.
+//! [`BasicIo`] on the chip: the two user outputs, the two user inputs, the front buttons, and
+//! with Wi-Fi the flash the settings live in.
 
 use esp_hal::gpio::{AnyPin, Input, InputConfig, Level, Output, OutputConfig, Pull};
 use firmware_basic::io::{BasicIo, Buttons, INPUT_PINS, OUTPUT_PINS};
+#[cfg(feature = "wifi")]
+use firmware_basic::wifi::{FlashWifiStore, WifiStore};
 
 /// The Basic's board IO.
 pub struct BoardIo<'d> {
@@ -11,6 +14,9 @@ pub struct BoardIo<'d> {
     inputs: [Input<'d>; 2],
     /// Buttons A, B, C.
     buttons: [Input<'d>; 3],
+    /// The Wi-Fi settings' flash ([`crate::network::SETTINGS_FLASH`] through esp-storage).
+    #[cfg(feature = "wifi")]
+    wifi: Option<FlashWifiStore<esp_storage::FlashStorage<'d>>>,
 }
 
 impl<'d> BoardIo<'d> {
@@ -26,7 +32,16 @@ impl<'d> BoardIo<'d> {
             outputs: outputs.map(|pin| Output::new(pin, Level::Low, OutputConfig::default())),
             inputs: inputs.map(|pin| Input::new(pin, floating)),
             buttons: buttons.map(|pin| Input::new(pin, floating)),
+            #[cfg(feature = "wifi")]
+            wifi: None,
         }
+    }
+
+    /// Lends the Basic `flash` for its Wi-Fi settings, from boot on.
+    #[cfg(feature = "wifi")]
+    pub fn with_wifi_flash(mut self, flash: esp_storage::FlashStorage<'d>) -> Self {
+        self.wifi = Some(FlashWifiStore::new(flash, crate::network::SETTINGS_FLASH));
+        self
     }
 }
 
@@ -59,5 +74,10 @@ impl BasicIo for BoardIo<'_> {
             b: b.is_low(),
             c: c.is_low(),
         }
+    }
+
+    #[cfg(feature = "wifi")]
+    fn wifi_store(&mut self) -> Option<&mut dyn WifiStore> {
+        self.wifi.as_mut().map(|store| store as &mut dyn WifiStore)
     }
 }

@@ -6,7 +6,9 @@
 //! * SPI: the ILI9342C LCD, showing the transponder's status one character per loop pass.
 //! * With the `wifi` feature: the Wi-Fi station and TCP server ([`network`]), under the esp-rtos
 //!   scheduler that esp-radio needs (the loop below is its main task, preempted by the radio's
-//!   tasks), with a heap of [`RECLAIMED_HEAP_BYTES`] + [`HEAP_BYTES`].
+//!   tasks), with a heap of [`RECLAIMED_HEAP_BYTES`] + [`HEAP_BYTES`]; the settings' flash is
+//!   lent to the Basic through [`board_io::BoardIo`], and TCP clients reach its router through
+//!   the library's [`firmware_basic::NetworkClients`], like the USB serial.
 //!
 //! Pins per chip are in [`pins`]; docs/boards.md says how to build and flash.
 #![no_std]
@@ -122,26 +124,29 @@ fn main() -> ! {
         .with_tx(pins.bus_tx)
         .with_rx(pins.bus_rx);
     let mut bus = UartPort::new(bus_uart, BUS_BAUD);
-    let mut io = BoardIo::new(pins.outputs, pins.inputs, pins.buttons);
+    let io = BoardIo::new(pins.outputs, pins.inputs, pins.buttons);
+    // The Wi-Fi settings: answered over 0xB0..0xB2 on every link, even if the radio fails.
+    #[cfg(feature = "wifi")]
+    let io = io.with_wifi_flash(esp_storage::FlashStorage::new(p.FLASH));
+    let mut io = io;
 
     let mut basic = Basic::new(BasicConfig::default());
 
     // Wi-Fi needs the scheduler running before the radio starts; a radio that does not start
     // leaves the transponder running without Wi-Fi.
     #[cfg(feature = "wifi")]
-    let (mut network, mut tcp_clients) = {
+    let (mut network, mut clients) = {
         esp_alloc::heap_allocator!(#[esp_hal::ram(reclaimed)] size: RECLAIMED_HEAP_BYTES);
         esp_alloc::heap_allocator!(size: HEAP_BYTES);
         let timg0 = esp_hal::timer::timg::TimerGroup::new(p.TIMG0);
         esp_rtos::start(timg0.timer0, p.FROM_CPU_INTR0);
         let rng = esp_hal::rng::Rng::new();
         let seed = (u64::from(rng.random()) << 32) | u64::from(rng.random());
-        let network = network::Network::start(now_us(), p.WIFI, p.FLASH, seed);
+        let network = network::Network::start(now_us(), p.WIFI, seed);
         if network.is_err() {
             board_log!("Wi-Fi did not start; running without it");
         }
-        // INTEGRATION POINT: the router takes TCP clients' bytes here once it is merged.
-        (network.ok(), network::DiscardClients::default())
+        (network.ok(), firmware_basic::NetworkClients::new())
     };
 
     let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, now_us());
@@ -150,16 +155,20 @@ fn main() -> ! {
     loop {
         let now = now_us();
         loop_time.pass(now);
+        #[cfg(not(feature = "wifi"))]
         basic.poll(now, &mut host, &mut bus, &mut io);
         #[cfg(feature = "wifi")]
-        if let Some(network) = &mut network {
-            network.poll(now, &mut tcp_clients);
+        {
+            clients.poll_basic(&mut basic, now, &mut host, &mut bus, &mut io);
+            if let Some(network) = &mut network {
+                network.poll(now, &mut basic, &mut clients);
+            }
         }
         if let Some(screen) = &mut screen {
             screen.update(now, basic.status(), || BoardStatus {
                 loop_max_us: loop_time.max_us(),
                 #[cfg(feature = "wifi")]
-                wifi: network.as_ref().map(network::Network::status),
+                wifi: basic.wifi_status(clients.count()),
                 #[cfg(not(feature = "wifi"))]
                 wifi: None,
             });

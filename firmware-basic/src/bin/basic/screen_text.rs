@@ -4,7 +4,7 @@
 
 use core::fmt::{self, Write};
 
-use firmware_basic::wifi::{Failure, JoinFailure, StationState, WifiStatus};
+use firmware_basic::wifi::{Failure, JoinFailure, StationState, WifiError, WifiStatus};
 use firmware_basic::{AtomLink, BasicError, BasicStatus, TransponderMode};
 
 /// Text columns: 320 px / 10 px.
@@ -137,6 +137,8 @@ fn write_row(out: &mut Line, row: usize, s: &BasicStatus) -> fmt::Result {
             }
             Some(BasicError::InvalidPin { pin }) => write!(out, "no such pin {pin}"),
             Some(BasicError::HostOverflow) => write!(out, "host link overflow"),
+            Some(BasicError::Wifi(WifiError::Refused(why))) => write!(out, "wifi: {why}"),
+            Some(BasicError::Wifi(WifiError::Flash(_))) => write!(out, "wifi: flash write failed"),
         },
         _ => Ok(()),
     }

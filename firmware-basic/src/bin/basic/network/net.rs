@@ -12,15 +12,15 @@ use core::net::Ipv4Addr;
 
 use esp_radio::wifi::{Interface as WifiInterface, WifiRxToken, WifiTxToken};
 use firmware_basic::wifi::LinkEvent;
+use firmware_basic::{Basic, NetClient, NetworkClients};
 use smoltcp::iface::{Config, Interface, SocketHandle, SocketSet, SocketStorage};
 use smoltcp::phy::{Device, DeviceCapabilities, Medium};
 use smoltcp::socket::{dhcpv4, tcp};
 use smoltcp::time::{Duration, Instant};
 use smoltcp::wire::{EthernetAddress, HardwareAddress, IpCidr, Ipv4Cidr};
 
-use super::TcpClients;
-
-/// TCP clients served at once. More are turned away (reset) while all are connected.
+/// TCP clients served at once. More are turned away (reset) while all are connected (or while
+/// the Basic's router has no link left: [`NetworkClients::connect`]).
 pub const TCP_SOCKETS: usize = 4;
 /// Each client's receive buffer, bytes: pymycobot sends one request (at most 68 bytes) and waits
 /// for its reply, so 1 KiB holds a long burst.
@@ -79,12 +79,11 @@ impl Device for WifiDevice {
     }
 }
 
-/// One TCP socket and whether its client has been handed to [`TcpClients`].
+/// One TCP socket and the client on it, once admitted ([`NetworkClients::connect`]).
 #[derive(Clone, Copy)]
 struct Slot {
     handle: SocketHandle,
-    /// The client was announced ([`TcpClients::connected`]) and not yet gone.
-    open: bool,
+    client: Option<NetClient>,
 }
 
 /// The network stack: interface, DHCP client and the TCP sockets.
@@ -127,7 +126,7 @@ impl Net {
             socket.set_nagle_enabled(false);
             Slot {
                 handle: sockets.add(socket),
-                open: false,
+                client: None,
             }
         });
         Self {
@@ -142,11 +141,6 @@ impl Net {
         }
     }
 
-    /// Clients connected now.
-    pub fn clients(&self) -> u8 {
-        self.slots.iter().filter(|s| s.open).count() as u8
-    }
-
     /// The link is up: forget any address and ask DHCP for one.
     pub fn start_dhcp(&mut self) {
         self.set_address(None);
@@ -154,12 +148,23 @@ impl Net {
         self.up = true;
     }
 
-    /// The network is gone: drop the address and every client (told to `clients`).
-    pub fn down(&mut self, clients: &mut impl TcpClients) {
+    /// The network is going: every client's connection is closed once what was queued for it
+    /// has been sent (a FIN after the data), so the last answers still leave. [`Self::down`]
+    /// follows.
+    pub fn close_gracefully(&mut self) {
+        for slot in &self.slots {
+            if slot.client.is_some() {
+                self.sockets.get_mut::<tcp::Socket>(slot.handle).close();
+            }
+        }
+    }
+
+    /// The network is gone: drop the address and every client (their links on `basic` closed).
+    pub fn down(&mut self, basic: &mut Basic, clients: &mut NetworkClients) {
         self.up = false;
         self.set_address(None);
         for index in 0..TCP_SOCKETS {
-            self.close(index, clients);
+            self.close(index, basic, clients);
         }
     }
 
@@ -179,8 +184,13 @@ impl Net {
     }
 
     /// One bounded round of network work at `now_us`; returns what DHCP reported, if anything.
-    /// Client bytes go to and come from `clients`.
-    pub fn poll(&mut self, now_us: u64, clients: &mut impl TcpClients) -> Option<LinkEvent> {
+    /// Client bytes go to and come from `clients` (new clients get a link on `basic`).
+    pub fn poll(
+        &mut self,
+        now_us: u64,
+        basic: &mut Basic,
+        clients: &mut NetworkClients,
+    ) -> Option<LinkEvent> {
         let now = timestamp(now_us);
         self.iface.poll_maintenance(now);
         for _ in 0..INGRESS_PER_POLL {
@@ -193,7 +203,7 @@ impl Net {
         }
         let event = self.poll_dhcp();
         for index in 0..TCP_SOCKETS {
-            self.serve(index, clients);
+            self.serve(index, basic, clients);
         }
         self.iface
             .poll_egress(now, &mut self.device, &mut self.sockets);
@@ -234,15 +244,15 @@ impl Net {
         });
     }
 
-    /// Keeps socket `index` listening while there is an address, announces a new client once
-    /// its connection is established, moves its bytes, and ends it when it has gone or has
-    /// closed its side.
-    fn serve(&mut self, index: usize, clients: &mut impl TcpClients) {
+    /// Keeps socket `index` listening while there is an address, admits a new client once its
+    /// connection is established (or turns it away), moves its bytes, and ends it when it has
+    /// gone or has closed its side.
+    fn serve(&mut self, index: usize, basic: &mut Basic, clients: &mut NetworkClients) {
         let Some(slot) = self.slots.get(index).copied() else {
             return;
         };
         let socket = self.sockets.get_mut::<tcp::Socket>(slot.handle);
-        if !slot.open {
+        let Some(client) = slot.client else {
             match socket.state() {
                 tcp::State::Closed => {
                     if self.address.is_some() && self.port != 0 {
@@ -250,54 +260,53 @@ impl Net {
                     }
                 }
                 tcp::State::Listen | tcp::State::SynReceived => {}
-                tcp::State::Established => {
-                    if clients.connected(index) {
-                        self.set_open(index, true);
-                    } else {
-                        socket.abort();
-                    }
-                }
-                // Closed by the client before it was announced.
+                tcp::State::Established => match clients.connect(basic) {
+                    Some(client) => self.set_client(index, Some(client)),
+                    // Every link in use: turned away at once.
+                    None => socket.abort(),
+                },
+                // Closed by the client before it was admitted.
                 _ => socket.abort(),
             }
             return;
-        }
+        };
         let mut chunk = [0u8; TCP_CHUNK];
         if socket.can_recv() {
-            // Peeked, then taken as far as the client took it: the rest waits in the socket
-            // (TCP flow control slows a client the Basic cannot keep up with).
+            // Peeked, then taken as far as the client's buffer took it: the rest waits in the
+            // socket (TCP flow control slows a client the Basic cannot keep up with).
             if let Ok(n) = socket.peek_slice(&mut chunk) {
-                let taken = clients.received(index, chunk.get(..n).unwrap_or(&[]));
+                let taken = clients.receive(client, chunk.get(..n).unwrap_or(&[]));
                 let _ = socket.recv_slice(chunk.get_mut(..taken.min(n)).unwrap_or(&mut []));
             }
         }
         if socket.can_send() {
             let room = socket.send_capacity() - socket.send_queue();
             let out = chunk.get_mut(..room.min(TCP_CHUNK)).unwrap_or(&mut []);
-            let n = clients.transmit(index, out);
+            let n = clients.transmit(client, out);
             let _ = socket.send_slice(chunk.get(..n).unwrap_or(&[]));
         }
-        // Gone (reset, timed out), or done sending and all it sent taken.
+        // Gone (reset, timed out, closed by us and done), or done sending and all it sent
+        // taken.
         if !socket.is_active() || !socket.may_recv() {
-            self.close(index, clients);
+            self.close(index, basic, clients);
         }
     }
 
-    /// Ends the client on socket `index`, if there is one.
-    fn close(&mut self, index: usize, clients: &mut impl TcpClients) {
+    /// Ends the client on socket `index`, if there is one: its link on `basic` is closed.
+    fn close(&mut self, index: usize, basic: &mut Basic, clients: &mut NetworkClients) {
         let Some(slot) = self.slots.get(index).copied() else {
             return;
         };
         self.sockets.get_mut::<tcp::Socket>(slot.handle).abort();
-        if slot.open {
-            self.set_open(index, false);
-            clients.disconnected(index);
+        if let Some(client) = slot.client {
+            self.set_client(index, None);
+            clients.disconnect(basic, client);
         }
     }
 
-    fn set_open(&mut self, index: usize, open: bool) {
+    fn set_client(&mut self, index: usize, client: Option<NetClient>) {
         if let Some(slot) = self.slots.get_mut(index) {
-            slot.open = open;
+            slot.client = client;
         }
     }
 }
