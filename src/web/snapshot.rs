@@ -196,14 +196,7 @@ mod tests {
     }
 
     fn pose(v: [i16; 6]) -> Pose {
-        Pose {
-            x: DeciMm(v[0]),
-            y: DeciMm(v[1]),
-            z: DeciMm(v[2]),
-            rx: Centideg(v[3]),
-            ry: Centideg(v[4]),
-            rz: Centideg(v[5]),
-        }
+        Pose::from_array(v)
     }
 
     #[test]
