@@ -10,10 +10,12 @@ use std::sync::Arc;
 use clap::Parser;
 use firmware_basic::wifi::WifiConfig;
 use open_mycobot::host::cli::{Cli, default_basic_flash};
+use open_mycobot::host::emulated::{CONNECT_TIMEOUT, Chardev, EmulatedBoards};
 use open_mycobot::host::pty::PseudoTerminal;
 use open_mycobot::host::pty_link::PtyLink;
 use open_mycobot::host::realtime::{RealtimeDriver, ServedRobot, stop_on_signals};
 use open_mycobot::host::tcp::TcpServer;
+use open_mycobot::sim::external::EmulatedArm;
 use open_mycobot::sim::{BasicFlashStore, RobotConfig, VirtualRobot};
 use open_mycobot::web::{self, Snapshot, StateBoard, WebServer};
 
@@ -33,6 +35,9 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
     let stop = stop_on_signals()?;
     let pty =
         PseudoTerminal::open().map_err(|e| format!("cannot create a pseudo-terminal: {e}"))?;
+    if let Some(atom) = cli.emulated_atom {
+        return serve_emulated(cli, atom, stop, pty);
+    }
     let flash_file = cli.basic_flash.clone().or_else(default_basic_flash);
     let mut flash = match &flash_file {
         Some(path) => BasicFlashStore::open(path)
@@ -118,6 +123,73 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
     }
     driver.run(&stop)?;
     drop(view);
+    drop(link);
+    let _ = writeln!(std::io::stdout(), "stopped");
+    Ok(())
+}
+
+/// The bus and servos serving emulated boards (`--emulated-*`): the Atom's bus UART at `atom`,
+/// the Basic's if given, and the pseudo-terminal on the front board's host UART. No 3D view
+/// and no TCP server: the firmware is the emulator's, and what the arm does is in its servos.
+fn serve_emulated(
+    cli: &Cli,
+    atom: std::net::SocketAddr,
+    stop: Arc<std::sync::atomic::AtomicBool>,
+    pty: PseudoTerminal,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let host = cli
+        .emulated_host
+        .ok_or("--emulated-host is needed with --emulated-atom")?;
+    let mut buses = vec![Chardev::connect("Atom's bus UART", atom, CONNECT_TIMEOUT)?];
+    if let Some(basic) = cli.emulated_basic {
+        buses.push(Chardev::connect(
+            "Basic's bus UART",
+            basic,
+            CONNECT_TIMEOUT,
+        )?);
+    }
+    let front_name = if cli.emulated_basic.is_some() {
+        "Basic's host UART"
+    } else {
+        "Atom's host UART"
+    };
+    let front = Chardev::connect(front_name, host, CONNECT_TIMEOUT)?;
+    let link = cli
+        .pty_link
+        .as_deref()
+        .map(|path| {
+            PtyLink::create(path, pty.slave_path())
+                .map_err(|e| format!("cannot create the link {}: {e}", path.display()))
+        })
+        .transpose()?;
+    let mut out = std::io::stdout().lock();
+    let boards = if cli.emulated_basic.is_some() {
+        "the emulated Basic and Atom"
+    } else {
+        "the emulated Atom"
+    };
+    writeln!(
+        out,
+        "virtual myCobot 280 bus with {boards}: the {} on {}",
+        front_name.replace("host UART", "USB serial"),
+        pty.slave_path().display()
+    )?;
+    if let Some(link) = &link {
+        writeln!(out, "pty link {}", link.path().display())?;
+    }
+    writeln!(out, "ready (Ctrl-C to stop)")?;
+    out.flush()?;
+    drop(out);
+
+    let robot = EmulatedBoards::new(
+        EmulatedArm::new(
+            RobotConfig::default().seed,
+            RobotConfig::default().initial_position_steps,
+        ),
+        buses,
+        front,
+    );
+    RealtimeDriver::new(robot, pty, None).run(&stop)?;
     drop(link);
     let _ = writeln!(std::io::stdout(), "stopped");
     Ok(())

@@ -46,6 +46,18 @@ pub struct Cli {
     /// Do not serve the 3D view.
     #[arg(long)]
     pub no_web: bool,
+    /// The Atom is an emulated chip running the real image (tools/emulate, docs/boards.md
+    /// "Emulated boards"): its bus UART (UART1) is the socket at ADDR:PORT (QEMU
+    /// `-serial tcp:ADDR:PORT,server=on`), on the simulated wire in place of the host-built Atom.
+    #[arg(long, value_name = "ADDR:PORT", requires = "emulated_host")]
+    pub emulated_atom: Option<SocketAddr>,
+    /// Like `--emulated-atom`, for the Basic: its bus UART is the socket at ADDR:PORT.
+    #[arg(long, value_name = "ADDR:PORT", requires_all = ["emulated_atom", "emulated_host"])]
+    pub emulated_basic: Option<SocketAddr>,
+    /// The emulated front board's host UART (UART0: the Basic's, or the Atom's when it is
+    /// alone) at ADDR:PORT: the pseudo-terminal's clients talk to it.
+    #[arg(long, value_name = "ADDR:PORT", requires = "emulated_atom", conflicts_with_all = ["tcp", "port"])]
+    pub emulated_host: Option<SocketAddr>,
 }
 
 /// Where the simulated Basic's flash is kept without `--basic-flash`: `open-mycobot/
@@ -119,6 +131,38 @@ mod tests {
         assert_eq!(HostLink::from(atom.port), HostLink::AtomUsb);
 
         assert!(Cli::try_parse_from(["open-mycobot", "--tcp", "9000"]).is_err());
+    }
+
+    #[test]
+    fn emulated_boards_need_a_host_uart_and_the_atom() {
+        let both = Cli::try_parse_from([
+            "open-mycobot",
+            "--emulated-atom",
+            "127.0.0.1:5001",
+            "--emulated-basic",
+            "127.0.0.1:5011",
+            "--emulated-host",
+            "127.0.0.1:5010",
+        ])
+        .unwrap();
+        assert_eq!(both.emulated_basic, Some("127.0.0.1:5011".parse().unwrap()));
+        let atom_alone = ["open-mycobot", "--emulated-atom", "127.0.0.1:5001"];
+        assert!(Cli::try_parse_from(atom_alone).is_err(), "no host UART");
+        let basic_alone = [
+            "--emulated-basic",
+            "127.0.0.1:5011",
+            "--emulated-host",
+            "127.0.0.1:5010",
+        ];
+        assert!(Cli::try_parse_from(std::iter::once("open-mycobot").chain(basic_alone)).is_err());
+        let with_tcp = [
+            "--emulated-atom",
+            "127.0.0.1:1",
+            "--emulated-host",
+            "127.0.0.1:2",
+            "--tcp",
+        ];
+        assert!(Cli::try_parse_from(std::iter::once("open-mycobot").chain(with_tcp)).is_err());
     }
 
     #[test]

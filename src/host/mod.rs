@@ -6,9 +6,12 @@
 //! * [`tcp`]: the host protocol over TCP, like the Basic's Wi-Fi server (`--tcp`);
 //! * [`pacer`]: client input paced to the serial line's speed, as a real port does;
 //! * [`realtime`]: the loop that runs the robot at wall-clock speed and moves the bytes;
+//! * [`emulated`]: the bus and servos serving the real images on emulated chips (QEMU), through
+//!   their UART sockets;
 //! * [`cli`]: the command line.
 
 pub mod cli;
+pub mod emulated;
 pub mod pacer;
 pub mod pty;
 pub mod pty_link;

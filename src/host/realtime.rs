@@ -78,6 +78,16 @@ pub trait RealtimeRobot {
     fn server_port(&self) -> Option<u16> {
         None
     }
+    /// Descriptors besides the clients' whose input must wake the loop at once (the sockets of
+    /// emulated boards). The default has none.
+    fn wake_fds(&self) -> Vec<BorrowedFd<'_>> {
+        Vec::new()
+    }
+    /// Whether something is under way inside the robot that needs the short tick even while no
+    /// client talks (bytes on an emulated board's bus). The default: never.
+    fn busy(&self) -> bool {
+        false
+    }
 }
 
 /// The virtual robot served on one of its USB ports.
@@ -222,7 +232,8 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
         let mut input = [0u8; 4096];
         let mut output = Vec::with_capacity(256);
         while !stop.load(Ordering::Relaxed) {
-            let active = last_traffic.is_some_and(|t| t.elapsed() < ACTIVE_SPELL);
+            let active =
+                self.robot.busy() || last_traffic.is_some_and(|t| t.elapsed() < ACTIVE_SPELL);
             let line_full = self.pacer.room(self.robot.now_us().saturating_mul(1_000)) == 0;
             self.wait_for_input(if active { ACTIVE_TICK } else { IDLE_TICK }, !line_full)?;
 
@@ -287,6 +298,7 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
         let mut fds: Vec<PollFd<'_>> = std::iter::once(pty_fd)
             .filter(|_| watch_pty)
             .chain(self.tcp.iter().flat_map(|tcp| tcp.poll_fds(has_room)))
+            .chain(self.robot.wake_fds())
             .map(|fd| PollFd::new(fd, PollFlags::POLLIN))
             .collect();
         match ppoll(&mut fds, Some(TimeSpec::from_duration(tick)), None) {

@@ -4,6 +4,8 @@
 //! * [`wire`]: the shared 1 Mbaud half-duplex bus (every station hears every byte, overlapping
 //!   transmissions garble each other, echo per station) and 115200 serial lines.
 //! * [`servo`]: a simulated STS servo: control table, instructions, trapezoidal motion, faults.
+//! * [`external`]: the same bus and servos serving boards that run elsewhere (the real images on
+//!   an emulated chip), whole frames in and the bus's bytes, echo included, out.
 //! * [`VirtualRobot`]: the real `firmware_basic::Basic` and `firmware_atom::Atom` wired to seven
 //!   servos; time advances only in [`VirtualRobot::run_until`], as fast as the host can.
 //!
@@ -34,6 +36,7 @@
 //! ```
 
 mod basic_flash;
+pub mod external;
 pub mod measure;
 mod robot;
 

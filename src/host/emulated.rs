@@ -1,0 +1,218 @@
+//! The virtual robot's bus and servos serving boards that run on an emulated chip: each
+//! board's UARTs are sockets (QEMU's `-serial tcp:ADDR,server=on`), this side connects.
+//!
+//! * A board's bus UART (UART1): what it sends goes on the simulated wire in whole frames, what
+//!   the wire carries (its own bytes too, as on the real boards) goes back to it
+//!   ([`crate::sim::external`]).
+//! * The front board's host UART (UART0): the pseudo-terminal's bytes go to it, its bytes to
+//!   the pseudo-terminal, as the real USB serial would.
+//!
+//! [`EmulatedBoards`] is a [`RealtimeRobot`]: the same real-time loop and pseudo-terminal serve
+//! it, and every socket wakes the loop as soon as it has bytes.
+
+use std::io::{self, ErrorKind, Read, Write};
+use std::net::{SocketAddr, TcpStream};
+use std::os::fd::{AsFd, BorrowedFd};
+use std::time::{Duration, Instant};
+
+use crate::sim::external::{BoardId, EmulatedArm};
+
+use super::realtime::RealtimeRobot;
+
+/// How long [`Chardev::connect`] keeps trying while the emulator starts.
+pub const CONNECT_TIMEOUT: Duration = Duration::from_secs(20);
+
+/// One emulated UART, reached through its socket (non-blocking).
+#[derive(Debug)]
+pub struct Chardev {
+    name: &'static str,
+    stream: TcpStream,
+    /// Bytes the socket did not take yet.
+    unsent: Vec<u8>,
+    closed: bool,
+}
+
+impl Chardev {
+    /// Connects to the emulator's socket at `addr`, trying again until `timeout` passes.
+    pub fn connect(name: &'static str, addr: SocketAddr, timeout: Duration) -> io::Result<Self> {
+        let deadline = Instant::now() + timeout;
+        let stream = loop {
+            match TcpStream::connect_timeout(&addr, Duration::from_secs(1)) {
+                Ok(stream) => break stream,
+                Err(e) if Instant::now() >= deadline => {
+                    return Err(io::Error::new(e.kind(), format!("{name} at {addr}: {e}")));
+                }
+                Err(_) => std::thread::sleep(Duration::from_millis(100)),
+            }
+        };
+        stream.set_nodelay(true)?;
+        stream.set_nonblocking(true)?;
+        Ok(Self {
+            name,
+            stream,
+            unsent: Vec::new(),
+            closed: false,
+        })
+    }
+
+    /// Appends to `out` every byte that has arrived.
+    fn read_into(&mut self, out: &mut Vec<u8>) {
+        let mut chunk = [0u8; 1024];
+        while !self.closed {
+            match self.stream.read(&mut chunk) {
+                Ok(0) => self.close("closed by the emulator"),
+                Ok(n) => out.extend_from_slice(chunk.get(..n).unwrap_or_default()),
+                Err(e) if e.kind() == ErrorKind::WouldBlock => break,
+                Err(e) if e.kind() == ErrorKind::Interrupted => {}
+                Err(e) => self.close(&e.to_string()),
+            }
+        }
+    }
+
+    /// Sends `bytes` (and what waited before them) as far as the socket takes them now.
+    fn send(&mut self, bytes: &[u8]) {
+        self.unsent.extend_from_slice(bytes);
+        while !self.closed && !self.unsent.is_empty() {
+            match self.stream.write(&self.unsent) {
+                Ok(n) => drop(self.unsent.drain(..n)),
+                Err(e) if e.kind() == ErrorKind::WouldBlock => break,
+                Err(e) if e.kind() == ErrorKind::Interrupted => {}
+                Err(e) => self.close(&e.to_string()),
+            }
+        }
+    }
+
+    fn close(&mut self, why: &str) {
+        if !self.closed {
+            eprintln!("open-mycobot: the emulated {} is gone ({why})", self.name);
+            self.closed = true;
+            self.unsent.clear();
+        }
+    }
+}
+
+/// The simulated bus and servos with emulated boards on it, served in real time. See the
+/// [module doc](self).
+#[derive(Debug)]
+pub struct EmulatedBoards {
+    arm: EmulatedArm,
+    buses: Vec<(BoardId, Chardev)>,
+    front: Chardev,
+    scratch: Vec<u8>,
+}
+
+impl EmulatedBoards {
+    /// `arm` with a board attached for each bus socket, and the front board's host UART.
+    pub fn new(mut arm: EmulatedArm, buses: Vec<Chardev>, front: Chardev) -> Self {
+        let buses = buses
+            .into_iter()
+            .map(|chardev| (arm.attach_board(), chardev))
+            .collect();
+        Self {
+            arm,
+            buses,
+            front,
+            scratch: Vec::new(),
+        }
+    }
+
+    /// The bus and servos.
+    pub fn arm(&self) -> &EmulatedArm {
+        &self.arm
+    }
+}
+
+impl RealtimeRobot for EmulatedBoards {
+    fn now_us(&self) -> u64 {
+        self.arm.now_us()
+    }
+
+    fn host_write(&mut self, bytes: &[u8]) {
+        self.front.send(bytes);
+    }
+
+    fn host_read(&mut self, out: &mut Vec<u8>) {
+        self.front.read_into(out);
+    }
+
+    fn run_until(&mut self, t_us: u64) {
+        for (board, chardev) in &mut self.buses {
+            self.scratch.clear();
+            chardev.read_into(&mut self.scratch);
+            self.arm.board_sent(*board, &self.scratch);
+        }
+        self.arm.run_until(t_us);
+        for (board, chardev) in &mut self.buses {
+            self.scratch.clear();
+            self.arm.board_received(*board, &mut self.scratch);
+            chardev.send(&self.scratch);
+        }
+    }
+
+    fn wake_fds(&self) -> Vec<BorrowedFd<'_>> {
+        self.buses
+            .iter()
+            .map(|(_, chardev)| chardev)
+            .chain(std::iter::once(&self.front))
+            .filter(|chardev| !chardev.closed)
+            .map(|chardev| chardev.stream.as_fd())
+            .collect()
+    }
+
+    fn busy(&self) -> bool {
+        self.arm.busy()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::net::TcpListener;
+
+    /// An emulated Atom that asks servo 1 for its position: the frame goes on the wire whole,
+    /// and the Atom's socket gets its echo and the servo's answer.
+    #[test]
+    fn a_board_on_a_socket_reads_a_servo() {
+        let bus_end = TcpListener::bind("127.0.0.1:0").unwrap();
+        let front_end = TcpListener::bind("127.0.0.1:0").unwrap();
+        let bus = Chardev::connect(
+            "Atom's bus UART",
+            bus_end.local_addr().unwrap(),
+            CONNECT_TIMEOUT,
+        );
+        let front = Chardev::connect(
+            "Atom's host UART",
+            front_end.local_addr().unwrap(),
+            CONNECT_TIMEOUT,
+        );
+        let (mut board, _) = bus_end.accept().unwrap();
+        let _front_peer = front_end.accept().unwrap();
+        let mut boards = EmulatedBoards::new(
+            EmulatedArm::new(1, 2048),
+            vec![bus.unwrap()],
+            front.unwrap(),
+        );
+        let read = [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE];
+        board.write_all(&read).unwrap();
+        board
+            .set_read_timeout(Some(Duration::from_secs(5)))
+            .unwrap();
+        let mut heard = Vec::new();
+        let mut t = 0;
+        while heard.len() < read.len() + 8 {
+            t += 100;
+            boards.run_until(t);
+            let mut chunk = [0u8; 64];
+            board.set_nonblocking(true).unwrap();
+            if let Ok(n) = board.read(&mut chunk) {
+                heard.extend_from_slice(&chunk[..n]);
+            }
+            assert!(t < 1_000_000, "no answer: {heard:02X?}");
+        }
+        assert_eq!(&heard[..8], &read, "the echo of its own frame");
+        assert_eq!(
+            &heard[8..16],
+            &[0xFF, 0xFF, 0x01, 0x04, 0x00, 0x00, 0x08, 0xF2]
+        );
+    }
+}

@@ -1,0 +1,304 @@
+//! Boards that run outside the simulation (an emulated chip running the real image): their bus
+//! UART is a byte stream, and here they are stations on the simulated bus like any other.
+//!
+//! * [`FrameGate`]: what a board sends arrives in chunks, whenever the emulator and the socket
+//!   pass it on; a real UART sends a frame back to back, and the bus ends a frame at a 200 us
+//!   gap. The gate holds bytes until they make a whole frame (a host frame `FE FE LEN ...` or a
+//!   servo packet `FF FF ID LEN ...`) and lets it onto the wire in one piece; bytes that make
+//!   no frame pass once nothing more has come for [`STALE_AFTER_NS`].
+//! * [`EmulatedArm`]: the simulated bus and seven servos with external boards attached. Each
+//!   hears the bus as its station does (its own bytes too: the boards' TX and RX are tied, and
+//!   an emulated UART has no echo of its own); time advances in [`EmulatedArm::run_until`].
+
+use protocol_core::BytePort;
+
+use super::robot::SERVO_IDS;
+use super::servo::SimServo;
+use super::wire::{Bus, HeardByte, StationId};
+use sim_hw::ServoChain;
+
+/// How long the bytes of an unfinished frame wait for the rest before they go on the wire as
+/// they are (garbage the board sent, or a frame cut short): far longer than any chunking of a
+/// frame by the emulator, far shorter than any reply deadline's retry.
+pub const STALE_AFTER_NS: u64 = 2_000_000;
+
+/// Most bytes a gate holds: a frame is at most 258 bytes; beyond this the oldest go at once.
+const GATE_BYTES: usize = 1024;
+
+/// Collects what a board sends and releases whole frames. See the [module doc](self).
+#[derive(Clone, Debug, Default)]
+pub struct FrameGate {
+    held: Vec<u8>,
+    last_byte_ns: u64,
+}
+
+impl FrameGate {
+    /// An empty gate.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Bytes the board sent, arrived at `now_ns`.
+    pub fn push(&mut self, now_ns: u64, bytes: &[u8]) {
+        if !bytes.is_empty() {
+            self.held.extend_from_slice(bytes);
+            self.last_byte_ns = now_ns;
+        }
+    }
+
+    /// Appends to `out` what may go on the wire at `now_ns`: every whole frame, the bytes before
+    /// a frame's start that belong to none, and everything once it is stale.
+    pub fn release(&mut self, now_ns: u64, out: &mut Vec<u8>) {
+        let stale = now_ns.saturating_sub(self.last_byte_ns) >= STALE_AFTER_NS;
+        let mut ready = 0;
+        loop {
+            let rest = self.held.get(ready..).unwrap_or_default();
+            match frame_extent(rest) {
+                Extent::Whole(n) | Extent::NotAFrame(n) => ready += n,
+                Extent::Partial if stale || rest.len() > GATE_BYTES => ready = self.held.len(),
+                Extent::Partial | Extent::Empty => break,
+            }
+        }
+        out.extend(self.held.drain(..ready));
+    }
+
+    /// When held bytes go stale, if any are held.
+    pub fn next_event_ns(&self) -> Option<u64> {
+        (!self.held.is_empty()).then(|| self.last_byte_ns.saturating_add(STALE_AFTER_NS))
+    }
+}
+
+/// What the start of a byte stream is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Extent {
+    /// Nothing at all.
+    Empty,
+    /// A whole host frame or servo packet of this many bytes.
+    Whole(usize),
+    /// The start of a frame whose rest has not come yet.
+    Partial,
+    /// This many bytes before anything that could start a frame.
+    NotAFrame(usize),
+}
+
+fn frame_extent(bytes: &[u8]) -> Extent {
+    // Host frames: FE FE LEN CMD DATA FA, LEN counting from CMD to FA. Servo packets:
+    // FF FF ID LEN INSTR PARAMS CHECKSUM, LEN counting from INSTR to the checksum.
+    let (len_at, extra) = match bytes {
+        [] => return Extent::Empty,
+        [0xFE] | [0xFF] => return Extent::Partial,
+        [0xFE, 0xFE, ..] => (2, 3),
+        [0xFF, 0xFF, ..] => (3, 4),
+        _ => {
+            let start = bytes
+                .iter()
+                .skip(1)
+                .position(|&b| b == 0xFE || b == 0xFF)
+                .map_or(bytes.len(), |i| i + 1);
+            return Extent::NotAFrame(start);
+        }
+    };
+    match bytes.get(len_at) {
+        None => Extent::Partial,
+        Some(&len) => {
+            let total = usize::from(len) + extra;
+            if bytes.len() >= total {
+                Extent::Whole(total)
+            } else {
+                Extent::Partial
+            }
+        }
+    }
+}
+
+/// A board outside the simulation, as a station on the bus.
+#[derive(Clone, Debug)]
+struct ExternalBoard {
+    station: StationId,
+    gate: FrameGate,
+    /// What the board's UART receives, waiting to be taken.
+    heard: Vec<u8>,
+}
+
+/// The simulated bus and servos serving boards that run elsewhere. See the [module doc](self).
+#[derive(Clone, Debug)]
+pub struct EmulatedArm {
+    now_ns: u64,
+    bus: Bus,
+    servos: ServoChain,
+    boards: Vec<ExternalBoard>,
+    heard: Vec<HeardByte>,
+    frame: Vec<u8>,
+}
+
+/// One of the boards of an [`EmulatedArm`], in the order they were attached.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BoardId(usize);
+
+impl EmulatedArm {
+    /// The bus with the seven servos at `initial_position_steps`, no board yet, at time 0.
+    pub fn new(seed: u64, initial_position_steps: u16) -> Self {
+        let mut bus = Bus::mycobot(seed);
+        let mut servos = ServoChain::new();
+        for &id in &SERVO_IDS {
+            servos.attach(&mut bus, SimServo::new(id, initial_position_steps));
+        }
+        bus.set_tap(true);
+        Self {
+            now_ns: 0,
+            bus,
+            servos,
+            boards: Vec::new(),
+            heard: Vec::new(),
+            frame: Vec::new(),
+        }
+    }
+
+    /// Attaches a board whose bus UART hears its own transmissions, as on both real boards.
+    pub fn attach_board(&mut self) -> BoardId {
+        let station = self.bus.attach(true);
+        self.boards.push(ExternalBoard {
+            station,
+            gate: FrameGate::new(),
+            heard: Vec::new(),
+        });
+        BoardId(self.boards.len() - 1)
+    }
+
+    /// Virtual time, in microseconds.
+    pub fn now_us(&self) -> u64 {
+        self.now_ns / 1_000
+    }
+
+    /// Bytes `board` sent on its bus UART, arriving now; they go on the wire as whole frames.
+    pub fn board_sent(&mut self, board: BoardId, bytes: &[u8]) {
+        if let Some(b) = self.boards.get_mut(board.0) {
+            b.gate.push(self.now_ns, bytes);
+        }
+    }
+
+    /// Appends to `out` what `board`'s bus UART received so far.
+    pub fn board_received(&mut self, board: BoardId, out: &mut Vec<u8>) {
+        if let Some(b) = self.boards.get_mut(board.0) {
+            out.append(&mut b.heard);
+        }
+    }
+
+    /// The servo whose id is `id`.
+    pub fn servo(&self, id: u8) -> Option<&SimServo> {
+        self.servos.get(id)
+    }
+
+    /// Whether anything is under way on the bus: a byte, an answer due, held bytes.
+    pub fn busy(&self) -> bool {
+        self.bus.busy()
+            || self.servos.next_event_ns().is_some()
+            || self.boards.iter().any(|b| b.gate.next_event_ns().is_some())
+    }
+
+    /// Advances virtual time to `t_us`.
+    pub fn run_until(&mut self, t_us: u64) {
+        let target = t_us.saturating_mul(1_000);
+        self.step(self.now_ns);
+        while self.now_ns < target {
+            let mut next = target;
+            let events = [self.bus.next_event_ns(), self.servos.next_event_ns()];
+            let gates = self.boards.iter().filter_map(|b| b.gate.next_event_ns());
+            for t in events.into_iter().flatten().chain(gates) {
+                next = next.min(t);
+            }
+            self.step(next.max(self.now_ns + 1));
+        }
+    }
+
+    /// One instant: bytes that ended arrive, servos and boards hear them, answers and whole
+    /// frames start.
+    fn step(&mut self, now_ns: u64) {
+        self.now_ns = now_ns;
+        self.bus.deliver(now_ns);
+        self.bus.take_heard(&mut self.heard);
+        for heard in self.heard.drain(..) {
+            self.servos.hear(&heard);
+        }
+        self.servos.transmit_due(now_ns, &mut self.bus);
+        for board in &mut self.boards {
+            let Some(mut port) = self.bus.port(board.station) else {
+                continue;
+            };
+            while let Some(byte) = port.read_byte() {
+                board.heard.push(byte);
+            }
+            self.frame.clear();
+            board.gate.release(now_ns, &mut self.frame);
+            if !self.frame.is_empty() {
+                port.write(&self.frame);
+            }
+        }
+        self.bus.start_transmissions(now_ns);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn released(gate: &mut FrameGate, now_ns: u64) -> Vec<u8> {
+        let mut out = Vec::new();
+        gate.release(now_ns, &mut out);
+        out
+    }
+
+    #[test]
+    fn a_frame_in_chunks_goes_out_whole_and_garbage_passes() {
+        let mut gate = FrameGate::new();
+        gate.push(0, &[0xFE, 0xFE, 0x02]);
+        assert!(
+            released(&mut gate, 10).is_empty(),
+            "half a host frame waits"
+        );
+        gate.push(20, &[0x10, 0xFA, 0x01, 0x02, 0xFF, 0xFF, 0x01]);
+        assert_eq!(
+            released(&mut gate, 30),
+            [0xFE, 0xFE, 0x02, 0x10, 0xFA, 0x01, 0x02],
+            "the frame and the garbage after it go; the packet's start waits"
+        );
+        gate.push(40, &[0x04, 0x02, 0x38, 0x02, 0xBE]);
+        assert_eq!(
+            released(&mut gate, 50),
+            [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE]
+        );
+        assert_eq!(gate.next_event_ns(), None);
+    }
+
+    #[test]
+    fn an_unfinished_frame_goes_as_it_is_once_stale() {
+        let mut gate = FrameGate::new();
+        gate.push(1_000, &[0xFE, 0xFE, 0x10, 0x20]);
+        assert_eq!(gate.next_event_ns(), Some(1_000 + STALE_AFTER_NS));
+        assert!(released(&mut gate, STALE_AFTER_NS).is_empty());
+        assert_eq!(
+            released(&mut gate, 1_000 + STALE_AFTER_NS),
+            [0xFE, 0xFE, 0x10, 0x20]
+        );
+    }
+
+    #[test]
+    fn a_board_hears_its_own_frame_and_the_servo_answer() {
+        let mut arm = EmulatedArm::new(1, 2048);
+        let atom = arm.attach_board();
+        arm.run_until(100);
+        // READ servo 1, present position (0x38), 2 bytes.
+        let read = [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE];
+        arm.board_sent(atom, &read[..3]);
+        arm.run_until(150);
+        arm.board_sent(atom, &read[3..]);
+        arm.run_until(2_000);
+        let mut heard = Vec::new();
+        arm.board_received(atom, &mut heard);
+        assert_eq!(heard.get(..8), Some(&read[..]), "its own echo first");
+        let answer = heard.get(8..).unwrap_or_default();
+        assert_eq!(answer.get(..5), Some(&[0xFF, 0xFF, 0x01, 0x04, 0x00][..]));
+        assert_eq!(answer.get(5..7), Some(&[0x00, 0x08][..]), "position 2048");
+        assert!(!arm.busy());
+    }
+}
