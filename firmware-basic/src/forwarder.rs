@@ -6,25 +6,34 @@
 //! ([`timing::BUS_QUIET_BEFORE_SEND_US`]), early enough in the Atom's gap between servo
 //! transactions that the Atom hears it before it would start its next one
 //! ([`LATEST_START_IN_GAP_US`]), or once the gap has visibly ended with nobody talking
-//! ([`ATOM_START_SEEN_US`]). The listener reads its echo back and judges it ([`Echo`]); a
-//! collision (echo differs, or a foreign byte while transmitting) is retransmitted after a
-//! growing back-off, at most [`BasicConfig::max_send_attempts`] times. An echo that is missing
-//! or cut short proves nothing (the frame may have gone out and only our receiver missed it),
-//! so it is retransmitted only if repeating the request is harmless.
-//! Then only a complete `FE FE` frame with the request's CMD byte counts as the reply; servo
-//! packets, other frames and late duplicates are dropped, and a request that gets no reply is
+//! ([`ATOM_START_SEEN_US`]). The listener reads its echo back and judges it ([`Echo`]). A
+//! collision that the echo proves (the line is known to echo, and what came back differed: the
+//! Atom heard the same garbled bytes) is retransmitted after a growing back-off, at most
+//! [`BasicConfig::max_send_attempts`] times. Nothing else makes the Basic send a client's
+//! request again: an echo that is missing or cut short, another station's bytes heard while
+//! transmitting on a line not known to echo, a reply that comes garbled or late - the request
+//! may have reached the Atom, and a client's request reaches the Atom at most once
+//! ([`may_resend`]). The client resends if it wants (pymycobot after 0.5 s).
+//!
+//! Then only a complete `FE FE` frame with the request's CMD counts as the reply; servo
+//! packets, other frames and late replies are dropped, and a request that gets no reply is
 //! given up after its deadline so the next one can go. The next request is the caller's choice
 //! (the [`crate::router`]'s turn, or the Basic's own), started only while the forwarder has
 //! none in flight.
 //!
-//! A reply garbled on the wire (the start of a frame heard but no valid frame, or a frame for
-//! another command) is lost for good: the Atom does not know. The Basic then sends the request again at once, instead of
-//! leaving the host to wait 0.5 s and resend it itself - unless repeating it could move the
-//! arm twice or act twice otherwise ([`is_repeatable`]: the incremental jogs 0x33 and 0x34, the
-//! next drag-teaching point 0xF3, move round 0xD4).
+//! **Late replies.** A request given up after its deadline may still be answered (a slow
+//! Atom; under emulation, any Atom). The Atom answers one request at a time, in order, so the
+//! forwarder keeps the last few requests it gave up on ([`MAX_LATE`], for
+//! [`LATE_REPLY_WINDOW_US`]) and takes a frame with one of their CMDs for the oldest such
+//! request's reply: that reply goes to nobody but the status ([`Event::Late`]), and is never
+//! taken for the reply to the request now in flight, nor for a garbled one. Only when the
+//! request in flight asks the same as the late one, for the same client (its resend), does the
+//! late reply answer it.
+//!
+//! The Basic's own requests (0x12, and 0x10 to an Atom that said it is off) are asked again
+//! at once when their reply comes garbled or their echo is missing: asking twice does no harm.
 
-use heapless::Vec;
-use protocol_core::command::cmd;
+use heapless::{Deque, Vec};
 use protocol_core::frame::{HEADER, MAX_FRAME_BYTES};
 use protocol_core::listener::{Echo, Heard, Listener};
 use protocol_core::{BytePort, Frame, timing};
@@ -58,19 +67,21 @@ pub fn may_start_after_quiet(quiet_us: u64) -> bool {
         || quiet_us >= ATOM_START_SEEN_US
 }
 
-/// True if sending `request` to the Atom twice does no harm: everything but the incremental
-/// jogs (0x33 jog increment angle, 0x34 jog increment coord / jog stop), which would move the
-/// arm twice as far, reading the next drag-teaching point (0xF3), which would skip one, and
-/// move round (0xD4), which would turn the dispenser twice.
-pub fn is_repeatable(request: &Frame) -> bool {
-    !matches!(
-        request.cmd(),
-        cmd::JOG_INCREMENT_ANGLE
-            | cmd::JOG_INCREMENT_COORD
-            | cmd::DRAG_GET_RECORD_DATA
-            | cmd::MOVE_ROUND
-    )
+/// True if the forwarder may send `request` again when it cannot tell whether the Atom got it
+/// (missing echo, garbled reply): only the Basic's own requests, which ask (0x12) or power on
+/// an Atom that said it is off (0x10). A client's request reaches the Atom at most once; the
+/// client resends if it wants.
+pub(crate) fn may_resend(request: &Request) -> bool {
+    !matches!(request.origin, Origin::Host(_))
 }
+
+/// How long after a request was given up on a frame with its CMD is still taken for its late
+/// reply, in microseconds: a client's deadline (pymycobot's 0.5 s resend).
+pub const LATE_REPLY_WINDOW_US: u64 = timing::HOST_REPLY_DEADLINE_US;
+
+/// Requests given up on whose late replies are recognised: more than a client's deadline's
+/// worth of timeouts of the Basic's own requests (50 ms each) would be needed to push one out.
+pub const MAX_LATE: usize = 8;
 
 /// Who asked for a request, and so where its reply goes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -106,6 +117,10 @@ pub(crate) enum Event {
     Expired(Request),
     /// A transmission collided and will be repeated.
     Collision,
+    /// `reply` answers `request`, which was given up on (timed out) before it came. Its
+    /// client, if any, has been told nothing and is not given it (it may have asked something
+    /// else since).
+    Late { request: Request, reply: Frame },
     /// A frame from the bus answered nothing outstanding and was dropped.
     Unsolicited,
 }
@@ -115,6 +130,7 @@ impl Event {
     pub(crate) fn origin(&self) -> Option<Origin> {
         match self {
             Self::Reply { request, .. }
+            | Self::Late { request, .. }
             | Self::Timeout(request)
             | Self::GaveUp(request)
             | Self::Expired(request) => Some(request.origin),
@@ -151,15 +167,28 @@ struct InFlight {
     stage: Stage,
 }
 
+/// A request given up on whose reply may still come.
+#[derive(Debug)]
+struct Late {
+    request: Request,
+    /// After this time a frame with its CMD is no longer taken for its reply.
+    until_us: u64,
+}
+
 /// The bus forwarder.
 #[derive(Debug)]
 pub(crate) struct Forwarder {
     current: Option<InFlight>,
+    /// Requests given up on, oldest first, whose replies may still come.
+    late: Deque<Late, MAX_LATE>,
 }
 
 impl Forwarder {
     pub(crate) const fn new() -> Self {
-        Self { current: None }
+        Self {
+            current: None,
+            late: Deque::new(),
+        }
     }
 
     /// True when no request is in flight: the next may start.
@@ -196,43 +225,45 @@ impl Forwarder {
         config: &BasicConfig,
         mut on_event: impl FnMut(Event),
     ) {
-        let silence_before = listener.quiet_us(now_us) > BURST_GAP_US;
+        let line = Line::now(now_us, listener);
         listener.push(now_us, byte, &mut |heard| {
-            self.on_heard(now_us, heard, silence_before, config, &mut on_event);
+            self.on_heard(now_us, heard, line, config, &mut on_event);
         });
         let garbled = matches!(
             &self.current,
             Some(InFlight { stage: Stage::AwaitReply { reply_started: true, .. }, request, .. })
-                if is_repeatable(&request.frame)
+                if may_resend(request)
         ) && !listener.frame_in_progress();
         if garbled {
             self.on_collision(now_us, config, &mut on_event);
         }
     }
 
-    /// Acts on what the listener heard; `silence_before` is whether the line was quiet
-    /// before the byte that brought it.
+    /// Acts on what the listener heard; `line` is what the line was like before the byte
+    /// (or the time) that brought it.
     fn on_heard(
         &mut self,
         now_us: u64,
         heard: Heard,
-        silence_before: bool,
+        line: Line,
         config: &BasicConfig,
         on_event: &mut impl FnMut(Event),
     ) {
         match heard {
-            Heard::Echo(echo) => self.on_echo(now_us, echo, config, on_event),
-            Heard::Byte(byte) => self.note_reply_byte(byte, silence_before),
-            Heard::Frame(frame) => self.on_frame(frame, on_event),
+            Heard::Echo(echo) => self.on_echo(now_us, echo, line.echoes, config, on_event),
+            Heard::Byte(byte) => self.note_reply_byte(byte, line.silence_before),
+            Heard::Frame(frame) => self.on_frame(now_us, frame, on_event),
             Heard::Packet(_) => {}
         }
     }
 
-    /// Follows the transmission in flight to its end, as the listener judged its echo.
+    /// Follows the transmission in flight to its end, as the listener judged its echo;
+    /// `echoes`: the line is known to echo, so a differing echo proves a collision.
     fn on_echo(
         &mut self,
         now_us: u64,
         echo: Echo,
+        echoes: bool,
         config: &BasicConfig,
         on_event: &mut impl FnMut(Event),
     ) {
@@ -244,17 +275,21 @@ impl Forwarder {
         else {
             return;
         };
-        let repeatable = is_repeatable(&request.frame);
+        let resend = may_resend(request);
         match echo {
             // The whole echo came back, or none (the wiring does not echo, as the listener
             // now knows): what arrives from now on is the Atom's.
             Echo::Whole | Echo::Silent => self.start_waiting(now_us, config),
-            // The echo differed: the Atom heard the same garbled bytes. Sent again once our
-            // transmitter is idle.
-            Echo::Differed => *collided = true,
+            // The echo differed on a line that echoes: the Atom heard the same garbled bytes,
+            // not the request. Sent again once our transmitter is idle.
+            Echo::Differed if echoes => *collided = true,
+            // Another station's bytes while ours went out, on a line not known to echo: an
+            // answer (early, or late to an earlier request) as likely as a collision, and the
+            // request may have arrived whole. Sent once: what comes now is the Atom's.
+            Echo::Differed => self.start_waiting(now_us, config),
             // The echo is missing or cut short: the frame may still have reached the Atom
-            // (bytes lost on our receive side). Send it again only if that is harmless.
-            Echo::Missing if repeatable => self.on_collision(now_us, config, on_event),
+            // (bytes lost on our receive side). Sent again only if that is harmless.
+            Echo::Missing if resend => self.on_collision(now_us, config, on_event),
             Echo::Missing => self.start_waiting(now_us, config),
         }
     }
@@ -291,10 +326,17 @@ impl Forwarder {
         config: &BasicConfig,
         mut on_event: impl FnMut(Event),
     ) {
-        let silence_before = listener.quiet_us(now_us) > BURST_GAP_US;
+        let line = Line::now(now_us, listener);
         listener.on_time(now_us, &mut |heard| {
-            self.on_heard(now_us, heard, silence_before, config, &mut on_event);
+            self.on_heard(now_us, heard, line, config, &mut on_event);
         });
+        while self
+            .late
+            .front()
+            .is_some_and(|late| now_us >= late.until_us)
+        {
+            self.late.pop_front();
+        }
         if matches!(
             self.current,
             Some(InFlight {
@@ -307,12 +349,33 @@ impl Forwarder {
             self.on_collision(now_us, config, &mut on_event);
         }
         if let Some(InFlight {
-            stage: Stage::AwaitReply { deadline_us, .. },
+            stage:
+                Stage::AwaitReply {
+                    deadline_us,
+                    reply_started,
+                    ..
+                },
             ..
         }) = &self.current
             && now_us >= *deadline_us
+            && let answer_heard = *reply_started
             && let Some(done) = self.current.take()
         {
+            // Unless a garbled answer was heard, its reply may still come: recognised as
+            // late, never taken for another's.
+            if answer_heard {
+                on_event(Event::Timeout(done.request));
+                return;
+            }
+            if self.late.is_full() {
+                self.late.pop_front();
+            }
+            let late = Late {
+                request: done.request.clone(),
+                until_us: now_us.saturating_add(LATE_REPLY_WINDOW_US),
+            };
+            // Cannot fail: there is room.
+            let _ = self.late.push_back(late);
             on_event(Event::Timeout(done.request));
         }
     }
@@ -382,7 +445,10 @@ impl Forwarder {
         flight.stage = Stage::Transmitting { collided: false };
     }
 
-    fn on_frame(&mut self, frame: Frame, on_event: &mut impl FnMut(Event)) {
+    fn on_frame(&mut self, now_us: u64, frame: Frame, on_event: &mut impl FnMut(Event)) {
+        if self.take_late_reply(now_us, &frame, on_event) {
+            return;
+        }
         // While waiting to send again, a reply to an earlier copy still answers the request.
         let answers = matches!(
             &self.current,
@@ -411,11 +477,87 @@ impl Forwarder {
             on_event(Event::Unsolicited);
         }
     }
+
+    /// Takes `frame` for the late reply to a request given up on, if it has the CMD of one
+    /// (the oldest: the Atom answers in order, so those before it will not be answered now).
+    /// The request in flight gets it too only if it asks the same for the same client.
+    fn take_late_reply(
+        &mut self,
+        now_us: u64,
+        frame: &Frame,
+        on_event: &mut impl FnMut(Event),
+    ) -> bool {
+        let Some(position) = self
+            .late
+            .iter()
+            .position(|late| late.request.frame.cmd() == frame.cmd() && now_us < late.until_us)
+        else {
+            return false;
+        };
+        let same_question = self.current.as_ref().is_some_and(|flight| {
+            matches!(flight.stage, Stage::AwaitReply { .. })
+                && self.late.get(position).is_some_and(|late| {
+                    late.request.frame == flight.request.frame
+                        && late.request.origin == flight.request.origin
+                })
+        });
+        if same_question {
+            // A resend of the question the late reply answers: it is the answer. The reply to
+            // the resend, still to come, then counts as the late one.
+            if let Some(done) = self.current.take() {
+                on_event(Event::Reply {
+                    request: done.request,
+                    reply: frame.clone(),
+                });
+            }
+            return true;
+        }
+        for _ in 0..position {
+            self.late.pop_front();
+        }
+        let Some(late) = self.late.pop_front() else {
+            return false;
+        };
+        if let Some(InFlight {
+            stage: Stage::AwaitReply { reply_started, .. },
+            ..
+        }) = &mut self.current
+        {
+            // Its first byte looked like the start of our reply; it was not.
+            *reply_started = false;
+        }
+        on_event(Event::Late {
+            request: late.request,
+            reply: frame.clone(),
+        });
+        true
+    }
+}
+
+/// What the line was like when a byte arrived (or time passed), before the listener acted on
+/// it.
+#[derive(Clone, Copy, Debug)]
+struct Line {
+    /// The line had been quiet: the byte begins a transmission.
+    silence_before: bool,
+    /// The line is known to echo, or the echo of this transmission has begun to come back: a
+    /// differing echo proves a collision.
+    echoes: bool,
+}
+
+impl Line {
+    fn now(now_us: u64, listener: &Listener) -> Self {
+        Self {
+            silence_before: listener.quiet_us(now_us) > BURST_GAP_US,
+            echoes: listener.echo_required() || listener.echo_coming_back(),
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use protocol_core::command::cmd;
 
     #[test]
     fn the_basic_starts_only_early_in_a_gap_or_after_it() {
@@ -433,19 +575,17 @@ mod tests {
     }
 
     #[test]
-    fn only_requests_that_act_twice_are_never_repeated() {
-        let frame = |cmd: u8, data: &[u8]| Frame::new(cmd, data).unwrap();
-        assert!(!is_repeatable(&frame(
-            cmd::JOG_INCREMENT_ANGLE,
-            &[1, 0, 100, 50]
-        )));
-        assert!(!is_repeatable(&frame(
-            cmd::JOG_INCREMENT_COORD,
-            &[1, 0, 100, 50]
-        )));
-        assert!(!is_repeatable(&frame(cmd::DRAG_GET_RECORD_DATA, &[])));
-        assert!(!is_repeatable(&frame(cmd::MOVE_ROUND, &[])));
-        assert!(is_repeatable(&frame(cmd::GET_ANGLES, &[])));
-        assert!(is_repeatable(&frame(cmd::SEND_ANGLES, &[0; 13])));
+    fn only_the_basics_own_requests_are_ever_sent_again() {
+        let request = |origin| Request {
+            frame: Frame::new(cmd::GET_ANGLES, &[]).unwrap(),
+            origin,
+            queued_us: 0,
+        };
+        let Some(client) = crate::router::Router::new().client(crate::router::LinkId::USB) else {
+            panic!("the USB link is always open");
+        };
+        assert!(!may_resend(&request(Origin::Host(client))));
+        assert!(may_resend(&request(Origin::Probe)));
+        assert!(may_resend(&request(Origin::PowerOn)));
     }
 }

@@ -25,9 +25,10 @@
 //!   streams both use them: a link each, bounded buffers both ways, the client limit.
 //! * [`forwarder`]: everything else goes onto the bus, one request at a time, into a quiet
 //!   wire, echo checked (heard or not: [`EchoMode::Auto`] finds out on the first send),
-//!   collisions and garbled replies retried; only the reply with the request's CMD comes back,
-//!   and a request the Atom does not answer is given up after
-//!   [`BasicConfig::reply_timeout_us`] (below pymycobot's 0.5 s resend).
+//!   collisions the echo proves retried; a client's request is otherwise never sent twice.
+//!   Only the reply with the request's CMD comes back, a request the Atom does not answer is
+//!   given up after [`BasicConfig::reply_timeout_us`] (below pymycobot's 0.5 s resend), and
+//!   its late reply is dropped, never taken for another request's.
 //! * [`transparent`]: after `0xC2 01` raw bytes go both ways (the Basic's echo removed)
 //!   between the bus and the client that switched, until it sends exactly
 //!   `FE FE 03 C2 00 FA` (or leaves); only that and the exact mode frames `FE FE 03 C2 01 FA`
@@ -46,7 +47,8 @@
 //!   a move the host already started is never cut short (0x10 makes the Atom hold the arm where
 //!   it is). Afterwards it probes the Atom (0x12) whenever it has been silent for
 //!   [`BasicConfig::probe_interval_us`]; the replies to these internal requests never reach
-//!   a client, they feed [`Basic::status`] (what the LCD shows). Button A powers the Atom on.
+//!   a client, they feed [`Basic::status`] (what the LCD shows). A press of button A powers the
+//!   Atom on, once (a button read as pressed from boot counts only after a release).
 //!
 //! How the ports are used, for whoever implements them: the Basic reads with
 //! [`BytePort::read_byte`] / [`HostPorts::read_from`] until it returns `None` (at most

@@ -76,6 +76,9 @@ pub struct BasicStatus {
     pub replies_forwarded: u32,
     /// Requests the Atom did not answer in time. Wraps.
     pub timeouts: u32,
+    /// Replies that came after their request was given up on: dropped, never given to a
+    /// client. Wraps.
+    pub late_replies: u32,
     /// Requests sent again (or given up) because they or their reply collided on the bus.
     /// Wraps.
     pub collisions: u32,
@@ -95,6 +98,7 @@ impl Default for BasicStatus {
             host_frames: 0,
             replies_forwarded: 0,
             timeouts: 0,
+            late_replies: 0,
             collisions: 0,
             transparent_dropped: 0,
         }

@@ -9,7 +9,9 @@
 //! having reached the Atom between that answer and the 0x10 (else it asks again). An Atom that is off runs no
 //! motion (it refuses moves while off), so this 0x10 stops nothing. A host power on, power off
 //! or release (0x10, 0x11, 0x13) decides the power itself, and the Basic no longer does.
-//! Button A is the user asking in person: it sends 0x10 at once.
+//! Button A is the user asking in person: a press (the button going from released to pressed)
+//! sends 0x10 at once, once; a button held, or read as pressed from boot (a stuck button, an
+//! emulator that reads every input as 0), does nothing until it has been released.
 
 use protocol_core::Frame;
 use protocol_core::command::cmd;
@@ -28,7 +30,7 @@ enum PowerTask {
     /// Make sure the Atom is on (boot): ask, and power on only if it is off. `off_seen`: it
     /// answered off, and no host request has been forwarded since.
     Ensure { off_seen: bool },
-    /// Power on now (button A).
+    /// Power on now, once (button A).
     Now,
 }
 
@@ -42,6 +44,9 @@ pub(crate) struct Supervisor {
     next_internal_us: u64,
     /// When the Atom last answered anything.
     last_answer_us: u64,
+    /// The buttons as last read. A press is a button going from released to pressed, so at
+    /// boot every button counts as held: one that reads pressed from the start must be
+    /// released before it counts.
     buttons: Buttons,
     /// Internal requests are tried again (probing is on).
     retries: bool,
@@ -61,7 +66,11 @@ impl Supervisor {
             },
             next_internal_us: 0,
             last_answer_us: 0,
-            buttons: Buttons::default(),
+            buttons: Buttons {
+                a: true,
+                b: true,
+                c: true,
+            },
             retries: config.probe_interval_us > 0,
         }
     }
@@ -119,8 +128,9 @@ impl Supervisor {
             }
             PowerTask::Done => return None,
         };
-        if !self.retries && origin == Origin::PowerOn {
-            // Without probing, a power-on is tried once.
+        if origin == Origin::PowerOn && (self.power == PowerTask::Now || !self.retries) {
+            // A press powers on once, answered or not (the user presses again); without
+            // probing, the boot's power-on is tried once too.
             self.power = PowerTask::Done;
         }
         self.next_internal_us = now_us.saturating_add(interval_us.max(1));
@@ -146,10 +156,39 @@ impl Supervisor {
     }
 
     /// An internal request of the Basic's got no answer. Without probing, the boot's question
-    /// is asked once.
+    /// is asked once; with it, an unanswered power-on is not sent again blindly: the Basic asks
+    /// first again.
     fn on_unanswered(&mut self, request: &Request) {
         if !self.retries && !matches!(request.origin, Origin::Host(_)) {
             self.power = PowerTask::Done;
+        }
+        if let (Origin::PowerOn, PowerTask::Ensure { off_seen }) = (request.origin, &mut self.power)
+        {
+            *off_seen = false;
+        }
+    }
+
+    /// The Atom answered `request` with `reply` (in time or late): what it says goes into the
+    /// status, and the Basic's own questions are settled.
+    fn on_answer(&mut self, now_us: u64, request: &Request, reply: &Frame) {
+        let status = &mut self.status;
+        status.atom = AtomLink::Answering;
+        self.last_answer_us = now_us;
+        let done = reply.data() == [1];
+        match (request.frame.cmd(), reply.data()) {
+            (cmd::POWER_ON, _) => {
+                // Answered either way: the Atom is alive and has decided.
+                status.atom_powered = Some(done);
+                if request.origin == Origin::PowerOn {
+                    self.power = PowerTask::Done;
+                }
+            }
+            (cmd::POWER_OFF, _) if done => status.atom_powered = Some(false),
+            (cmd::IS_POWER_ON, &[state]) => status.atom_powered = Some(state == 1),
+            _ => {}
+        }
+        if let (Origin::Probe, &[state]) = (request.origin, reply.data()) {
+            self.on_probe_answer(now_us, state == 1);
         }
     }
 
@@ -165,30 +204,18 @@ impl Supervisor {
             // it may have started something. Ask again.
             *off_seen = false;
         }
-        let status = &mut self.status;
         match event {
             Event::Reply { request, reply } => {
-                status.atom = AtomLink::Answering;
-                self.last_answer_us = now_us;
-                let done = reply.data() == [1];
-                match (request.frame.cmd(), reply.data()) {
-                    (cmd::POWER_ON, _) => {
-                        // Answered either way: the Atom is alive and has decided.
-                        status.atom_powered = Some(done);
-                        if request.origin == Origin::PowerOn {
-                            self.power = PowerTask::Done;
-                        }
-                    }
-                    (cmd::POWER_OFF, _) if done => status.atom_powered = Some(false),
-                    (cmd::IS_POWER_ON, &[state]) => status.atom_powered = Some(state == 1),
-                    _ => {}
-                }
-                if let (Origin::Probe, &[state]) = (request.origin, reply.data()) {
-                    self.on_probe_answer(now_us, state == 1);
-                }
+                self.on_answer(now_us, &request, &reply);
                 if let Origin::Host(client) = request.origin {
                     return Some((client, reply));
                 }
+            }
+            // Its client was given up on (and may have asked something else since): the
+            // reply goes only into the status.
+            Event::Late { request, reply } => {
+                self.on_answer(now_us, &request, &reply);
+                self.status.late_replies = self.status.late_replies.wrapping_add(1);
             }
             Event::Timeout(request) => {
                 self.on_unanswered(&request);

@@ -206,20 +206,43 @@ fn a_flood_to_a_dead_atom_neither_wedges_nor_replays_stale_commands() {
 
 #[test]
 fn a_collision_is_detected_and_the_request_sent_again() {
-    for echo in [true, false] {
-        let mut rig = Rig::quiet(echo);
-        let request = frame(GET_ANGLES, &[]);
-        rig.host.send(&request);
-        // The host frame's last byte ends at 5 byte times of 115200; the Basic starts sending
-        // right after. Another station talks over its second byte.
-        let host_end_ns = 5 * common::HOST_BYTE_NS;
-        rig.wire()
-            .inject(host_end_ns + BUS_BYTE_NS + 3_000, &[0x55, 0x55]);
-        rig.run_us(10_000);
-        assert!(rig.basic.status().collisions >= 1, "echo {echo}");
-        assert_eq!(rig.atom_got.len(), 1, "echo {echo}: one intact copy");
-        assert_eq!(rig.host.received(), angles_reply(), "echo {echo}");
-    }
+    let mut rig = Rig::quiet(true);
+    let request = frame(GET_ANGLES, &[]);
+    rig.host.send(&request);
+    // The host frame's last byte ends at 5 byte times of 115200; the Basic starts sending
+    // right after. Another station talks over its second byte.
+    let host_end_ns = 5 * common::HOST_BYTE_NS;
+    rig.wire()
+        .inject(host_end_ns + BUS_BYTE_NS + 3_000, &[0x55, 0x55]);
+    rig.run_us(10_000);
+    assert!(rig.basic.status().collisions >= 1);
+    assert_eq!(rig.atom_got.len(), 1, "one intact copy");
+    assert_eq!(rig.host.received(), angles_reply());
+}
+
+#[test]
+fn on_a_line_that_does_not_echo_bytes_heard_while_sending_never_repeat_a_request() {
+    // Without an echo the Basic cannot tell another station talking over its frame from an
+    // answer (early, or late to an earlier request) to a frame that arrived whole: it does not
+    // send it again. Here it was a collision: the request is lost, and the client resends.
+    let mut rig = Rig::quiet(false);
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    let host_end_ns = 5 * common::HOST_BYTE_NS;
+    rig.wire()
+        .inject(host_end_ns + BUS_BYTE_NS + 3_000, &[0x55, 0x55]);
+    rig.run_us(BasicConfig::default().reply_timeout_us + 10_000);
+    let sent_frames = rig
+        .wire()
+        .basic_sent
+        .iter()
+        .filter(|(_, b)| *b == 0xFA)
+        .count();
+    assert_eq!(sent_frames, 1, "sent once");
+    assert!(rig.host.received().is_empty());
+    assert_eq!(rig.basic.status().timeouts, 1);
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(5_000);
+    assert_eq!(rig.host.received(), angles_reply());
 }
 
 #[test]
@@ -377,6 +400,61 @@ fn button_a_powers_the_atom_on_again() {
     assert!(rig.host.received().is_empty());
 }
 
+/// Commands the Atom received, in order.
+fn cmds_got(rig: &Rig) -> Vec<u8> {
+    rig.atom_got.iter().map(|(_, f)| f.cmd()).collect()
+}
+
+#[test]
+fn a_button_read_pressed_from_boot_powers_nothing_until_released_and_pressed() {
+    // An emulator reads every input as 0: button A looks held from boot. The Atom does not
+    // answer (as when it is slow), and the Basic probes it.
+    let config = BasicConfig {
+        power_on_at_boot: false,
+        ..BasicConfig::default()
+    };
+    let mut rig = Rig::new(config, true);
+    rig.atom = Box::new(|_| None);
+    rig.step_ns = 20_000;
+    rig.io.buttons.a = true;
+    rig.run_us(3_000_000);
+    assert!(!cmds_got(&rig).contains(&0x10), "{:02x?}", cmds_got(&rig));
+    // Released, then pressed and held: one power on.
+    rig.io.buttons.a = false;
+    rig.run_us(100_000);
+    rig.io.buttons.a = true;
+    rig.run_us(3_000_000);
+    let power_ons = cmds_got(&rig).iter().filter(|&&c| c == 0x10).count();
+    assert_eq!(power_ons, 1, "{:02x?}", cmds_got(&rig));
+    // Each press is one more.
+    rig.io.buttons.a = false;
+    rig.run_us(100_000);
+    rig.io.buttons.a = true;
+    rig.run_us(100_000);
+    let power_ons = cmds_got(&rig).iter().filter(|&&c| c == 0x10).count();
+    assert_eq!(power_ons, 2, "{:02x?}", cmds_got(&rig));
+    assert!(rig.host.received().is_empty());
+}
+
+#[test]
+fn an_unanswered_boot_power_on_is_asked_about_again_not_resent_blindly() {
+    // The Atom says it is off, then stops answering.
+    let mut rig = Rig::new(BasicConfig::default(), true);
+    let mut asked = false;
+    rig.atom = Box::new(move |f: &Frame| {
+        if f.cmd() != IS_POWERED_ON || asked {
+            return None;
+        }
+        asked = true;
+        Some(frame(IS_POWERED_ON, &[0]))
+    });
+    rig.step_ns = 20_000;
+    rig.run_us(4_000_000);
+    let got = cmds_got(&rig);
+    assert_eq!(got.first(), Some(&IS_POWERED_ON), "{got:02x?}");
+    assert_eq!(got.iter().filter(|&&c| c == 0x10).count(), 1, "{got:02x?}");
+}
+
 #[test]
 fn an_atom_answering_right_after_the_request_is_not_mistaken_for_a_broken_echo() {
     for echo in [true, false] {
@@ -406,21 +484,36 @@ fn garbling_atom(garbled: usize) -> common::Responder {
 }
 
 #[test]
-fn a_garbled_reply_makes_the_basic_ask_again_at_once() {
+fn a_garbled_reply_is_lost_and_the_request_never_sent_again() {
     // The second header byte, LEN, CMD or the footer hit: the start of a reply was heard but
-    // no valid frame with our CMD came. (A hit data byte cannot be told: frames carry no
-    // checksum.)
+    // no valid frame with our CMD came. The request reached the Atom; sending it again would
+    // make it reach the Atom twice. The client resends if it wants.
     for garbled in [1, 2, 3, 5] {
         for echo in [true, false] {
             let mut rig = Rig::quiet(echo);
             rig.atom = garbling_atom(garbled);
             rig.host.send(&frame(IS_POWERED_ON, &[]));
-            rig.run_us(5_000);
+            rig.run_us(BasicConfig::default().reply_timeout_us + 10_000);
             let context = format!("byte {garbled}, echo {echo}");
+            assert_eq!(rig.atom_got.len(), 1, "{context}");
+            assert!(rig.host.received().is_empty(), "{context}");
+            // The client's resend is answered.
+            rig.host.send(&frame(IS_POWERED_ON, &[]));
+            rig.run_us(5_000);
             assert_eq!(rig.atom_got.len(), 2, "{context}");
             assert_eq!(rig.host.received(), frame(IS_POWERED_ON, &[1]), "{context}");
         }
     }
+}
+
+#[test]
+fn the_basics_own_question_is_asked_again_at_once_when_its_answer_comes_garbled() {
+    let mut rig = Rig::new(BasicConfig::default(), true);
+    rig.atom = garbling_atom(2);
+    rig.step_ns = 5_000;
+    rig.run_us(1_010_000);
+    assert_eq!(cmds_got(&rig), [IS_POWERED_ON, IS_POWERED_ON]);
+    assert_eq!(rig.basic.status().atom_powered, Some(true));
 }
 
 #[test]

@@ -306,6 +306,12 @@ impl Listener {
         self.frames.has_partial()
     }
 
+    /// True while part of the open transmission's echo has come back: the line echoes, even if
+    /// [`EchoMode::Auto`] has not judged a whole echo yet.
+    pub fn echo_coming_back(&self) -> bool {
+        self.window.is_some() && self.echoed > 0
+    }
+
     /// True while a transmission's echo verdict is still to come.
     pub fn echo_pending(&self) -> bool {
         self.window.is_some()
@@ -334,8 +340,11 @@ impl Listener {
         self.packets.checksum_errors()
     }
 
-    /// Whether the echo must come back whole for a transmission to count as sent intact.
-    fn echo_required(&self) -> bool {
+    /// Whether the echo must come back whole for a transmission to count as sent intact: the
+    /// line is known to echo ([`EchoMode::Present`], or [`EchoMode::Auto`] once a whole echo
+    /// came back). Only then does a differing echo prove a collision; on another line, a byte
+    /// heard while transmitting may as well be an answer (or a late one) to an intact frame.
+    pub fn echo_required(&self) -> bool {
         match self.config.echo {
             EchoMode::Present => true,
             EchoMode::Absent => false,

@@ -3,5 +3,7 @@
 
 #[path = "loop_time.rs"]
 mod loop_time;
+#[path = "radio_start.rs"]
+mod radio_start;
 #[path = "screen_text.rs"]
 mod screen_text;

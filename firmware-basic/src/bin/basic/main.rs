@@ -8,7 +8,9 @@
 //!   scheduler that esp-radio needs (the loop below is its main task, preempted by the radio's
 //!   tasks), with a heap of [`RECLAIMED_HEAP_BYTES`] + [`HEAP_BYTES`]; the settings' flash is
 //!   lent to the Basic through [`board_io::BoardIo`], and TCP clients reach its router through
-//!   the library's [`firmware_basic::NetworkClients`], like the USB serial.
+//!   the library's [`firmware_basic::NetworkClients`], like the USB serial. The radio starts on
+//!   a thread of its own while the loop already serves USB, with a deadline
+//!   ([`radio_start`]); the loop watchdog is armed before it.
 //!
 //! Pins per chip are in [`pins`]; docs/boards.md says how to build and flash.
 #![no_std]
@@ -28,6 +30,8 @@ mod loop_time;
 #[cfg(feature = "wifi")]
 mod network;
 mod pins;
+#[cfg_attr(not(feature = "wifi"), allow(dead_code))]
+mod radio_start;
 mod screen;
 mod screen_text;
 
@@ -132,24 +136,27 @@ fn main() -> ! {
 
     let mut basic = Basic::new(BasicConfig::default());
 
-    // Wi-Fi needs the scheduler running before the radio starts; a radio that does not start
-    // leaves the transponder running without Wi-Fi.
+    // Armed before anything that could hang: from here on only the loop below feeds it.
+    let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, now_us());
+
+    // Wi-Fi needs the scheduler running before the radio starts. The radio starts on a thread
+    // of its own, so the loop serves USB from its first pass whatever the radio does; one that
+    // is not up by its deadline (or fails) leaves the transponder without Wi-Fi, and the LCD
+    // says so (docs/boards.md, "Wi-Fi").
     #[cfg(feature = "wifi")]
-    let (mut network, mut clients) = {
+    let (mut wifi, mut clients) = {
         esp_alloc::heap_allocator!(#[esp_hal::ram(reclaimed)] size: RECLAIMED_HEAP_BYTES);
         esp_alloc::heap_allocator!(size: HEAP_BYTES);
         let timg0 = esp_hal::timer::timg::TimerGroup::new(p.TIMG0);
         esp_rtos::start(timg0.timer0, p.FROM_CPU_INTR0);
         let rng = esp_hal::rng::Rng::new();
         let seed = (u64::from(rng.random()) << 32) | u64::from(rng.random());
-        let network = network::Network::start(now_us(), p.WIFI, seed);
-        if network.is_err() {
-            board_log!("Wi-Fi did not start; running without it");
-        }
-        (network.ok(), firmware_basic::NetworkClients::new())
+        (
+            network::BoardWifi::begin(now_us(), p.WIFI, seed),
+            firmware_basic::NetworkClients::new(),
+        )
     };
 
-    let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, now_us());
     let mut loop_time = LoopTime::default();
 
     loop {
@@ -160,17 +167,19 @@ fn main() -> ! {
         #[cfg(feature = "wifi")]
         {
             clients.poll_basic(&mut basic, now, &mut host, &mut bus, &mut io);
-            if let Some(network) = &mut network {
-                network.poll(now, &mut basic, &mut clients);
-            }
+            wifi.poll(now, &mut basic, &mut clients);
         }
         if let Some(screen) = &mut screen {
             screen.update(now, basic.status(), || BoardStatus {
                 loop_max_us: loop_time.max_us(),
                 #[cfg(feature = "wifi")]
                 wifi: basic.wifi_status(clients.count()),
+                #[cfg(feature = "wifi")]
+                radio: Some(wifi.radio()),
                 #[cfg(not(feature = "wifi"))]
                 wifi: None,
+                #[cfg(not(feature = "wifi"))]
+                radio: None,
             });
             screen.draw_next();
         }

@@ -7,6 +7,8 @@ use core::fmt::{self, Write};
 use firmware_basic::wifi::{Failure, JoinFailure, StationState, WifiError, WifiStatus};
 use firmware_basic::{AtomLink, BasicError, BasicStatus, TransponderMode};
 
+use crate::radio_start::{RADIO_START_DEADLINE_US, RadioStart};
+
 /// Text columns: 320 px / 10 px.
 pub const COLS: usize = 32;
 /// Text rows: 240 px / 20 px.
@@ -34,6 +36,8 @@ pub struct BoardStatus {
     pub loop_max_us: u32,
     /// Wi-Fi, in a Wi-Fi build.
     pub wifi: Option<WifiStatus>,
+    /// The radio's start-up, in a Wi-Fi build.
+    pub radio: Option<RadioStart>,
 }
 
 /// The screen text for the transponder's `status` and the `board`'s.
@@ -44,12 +48,36 @@ pub fn render(status: &BasicStatus, board: &BoardStatus) -> Text {
         // `Line` never fails: what does not fit is cut off.
         let _ = match (row, &board.wifi) {
             (LOOP_ROW, _) => write!(line, "loop max  {} us", board.loop_max_us),
-            (WIFI_ROW | NET_ROW, Some(wifi)) => write_wifi_row(&mut line, row, wifi),
+            (WIFI_ROW | NET_ROW, Some(wifi)) => match board.radio {
+                Some(RadioStart::Up) | None => write_wifi_row(&mut line, row, wifi),
+                Some(radio) => write_radio_row(&mut line, row, radio, wifi),
+            },
             _ => write_row(&mut line, row, status),
         };
         *cells = line.cells;
     }
     text
+}
+
+/// Writes Wi-Fi row `row` (`WIFI_ROW` or `NET_ROW`) while the radio is not up: starting, or
+/// given up on (the Basic is a USB transponder then).
+fn write_radio_row(
+    out: &mut Line,
+    row: usize,
+    radio: RadioStart,
+    wifi: &WifiStatus,
+) -> fmt::Result {
+    match (row, radio) {
+        (WIFI_ROW, RadioStart::Starting { .. }) => write!(out, "wifi  radio starting"),
+        (WIFI_ROW, _) => write!(out, "wifi  FAILED, USB only"),
+        (_, RadioStart::Refused) => write!(out, "radio refused to start"),
+        (_, RadioStart::TimedOut) => write!(
+            out,
+            "radio not up in {} s",
+            RADIO_START_DEADLINE_US / 1_000_000
+        ),
+        _ => write!(out, "port {}", wifi.port),
+    }
 }
 
 /// Writes Wi-Fi row `row` (`WIFI_ROW` or `NET_ROW`).
@@ -296,6 +324,7 @@ mod tests {
         let board = |wifi: &WifiStatus| BoardStatus {
             loop_max_us: 412,
             wifi: Some(wifi.clone()),
+            radio: Some(RadioStart::Up),
         };
         let text = render(&basic, &board(&wifi));
         assert_eq!(row_text(&text, LOOP_ROW), "loop max  412 us");
@@ -395,5 +424,30 @@ mod tests {
                 byte: b' '
             }]
         );
+    }
+
+    #[test]
+    fn a_radio_that_did_not_start_is_shown_with_usb_still_served() {
+        let wifi = WifiStatus {
+            ssid: Some("robots".try_into().unwrap()),
+            state: StationState::Off,
+            port: 9000,
+            clients: 0,
+            last_failure: None,
+            settings_unreadable: false,
+        };
+        let board = |radio| BoardStatus {
+            loop_max_us: 50,
+            wifi: Some(wifi.clone()),
+            radio: Some(radio),
+        };
+        let text = render(&BasicStatus::default(), &board(RadioStart::begin(0)));
+        assert_eq!(row_text(&text, WIFI_ROW), "wifi  radio starting");
+        assert_eq!(row_text(&text, NET_ROW), "port 9000");
+        let text = render(&BasicStatus::default(), &board(RadioStart::TimedOut));
+        assert_eq!(row_text(&text, WIFI_ROW), "wifi  FAILED, USB only");
+        assert_eq!(row_text(&text, NET_ROW), "radio not up in 5 s");
+        let text = render(&BasicStatus::default(), &board(RadioStart::Refused));
+        assert_eq!(row_text(&text, NET_ROW), "radio refused to start");
     }
 }
