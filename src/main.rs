@@ -140,13 +140,15 @@ fn serve_emulated(
     let host = cli
         .emulated_host
         .ok_or("--emulated-host is needed with --emulated-atom")?;
-    let mut buses = vec![Chardev::connect("Atom's bus UART", atom, CONNECT_TIMEOUT)?];
+    // The Atom, the bus's master, starts a frame on a line with no byte under way; the Basic
+    // waits for the silence it waits for on the real bus.
+    let mut buses = vec![(
+        Chardev::connect("Atom's bus UART", atom, CONNECT_TIMEOUT)?,
+        0,
+    )];
     if let Some(basic) = cli.emulated_basic {
-        buses.push(Chardev::connect(
-            "Basic's bus UART",
-            basic,
-            CONNECT_TIMEOUT,
-        )?);
+        let chardev = Chardev::connect("Basic's bus UART", basic, CONNECT_TIMEOUT)?;
+        buses.push((chardev, protocol_core::timing::BUS_QUIET_BEFORE_SEND_US));
     }
     let front_name = if cli.emulated_basic.is_some() {
         "Basic's host UART"

@@ -2,8 +2,8 @@
 //! board's UARTs are sockets (QEMU's `-serial tcp:ADDR,server=on`), this side connects.
 //!
 //! * A board's bus UART (UART1): what it sends goes on the simulated wire in whole frames, what
-//!   the wire carries (its own bytes too, as on the real boards) goes back to it
-//!   ([`crate::sim::external`]).
+//!   the other stations send comes back to it ([`crate::sim::external`] says why not its own
+//!   echo).
 //! * The front board's host UART (UART0): the pseudo-terminal's bytes go to it, its bytes to
 //!   the pseudo-terminal, as the real USB serial would.
 //!
@@ -102,11 +102,12 @@ pub struct EmulatedBoards {
 }
 
 impl EmulatedBoards {
-    /// `arm` with a board attached for each bus socket, and the front board's host UART.
-    pub fn new(mut arm: EmulatedArm, buses: Vec<Chardev>, front: Chardev) -> Self {
+    /// `arm` with a board attached for each bus socket (with the silence its frames wait for
+    /// on the wire, [`EmulatedArm::attach_board`]), and the front board's host UART.
+    pub fn new(mut arm: EmulatedArm, buses: Vec<(Chardev, u64)>, front: Chardev) -> Self {
         let buses = buses
             .into_iter()
-            .map(|chardev| (arm.attach_board(), chardev))
+            .map(|(chardev, quiet_us)| (arm.attach_board(quiet_us), chardev))
             .collect();
         Self {
             arm,
@@ -170,7 +171,7 @@ mod tests {
     use std::net::TcpListener;
 
     /// An emulated Atom that asks servo 1 for its position: the frame goes on the wire whole,
-    /// and the Atom's socket gets its echo and the servo's answer.
+    /// and the Atom's socket gets the servo's answer.
     #[test]
     fn a_board_on_a_socket_reads_a_servo() {
         let bus_end = TcpListener::bind("127.0.0.1:0").unwrap();
@@ -189,17 +190,14 @@ mod tests {
         let _front_peer = front_end.accept().unwrap();
         let mut boards = EmulatedBoards::new(
             EmulatedArm::new(1, 2048),
-            vec![bus.unwrap()],
+            vec![(bus.unwrap(), 0)],
             front.unwrap(),
         );
         let read = [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE];
         board.write_all(&read).unwrap();
-        board
-            .set_read_timeout(Some(Duration::from_secs(5)))
-            .unwrap();
         let mut heard = Vec::new();
         let mut t = 0;
-        while heard.len() < read.len() + 8 {
+        while heard.len() < 8 {
             t += 100;
             boards.run_until(t);
             let mut chunk = [0u8; 64];
@@ -209,10 +207,6 @@ mod tests {
             }
             assert!(t < 1_000_000, "no answer: {heard:02X?}");
         }
-        assert_eq!(&heard[..8], &read, "the echo of its own frame");
-        assert_eq!(
-            &heard[8..16],
-            &[0xFF, 0xFF, 0x01, 0x04, 0x00, 0x00, 0x08, 0xF2]
-        );
+        assert_eq!(heard, [0xFF, 0xFF, 0x01, 0x04, 0x00, 0x00, 0x08, 0xF2]);
     }
 }

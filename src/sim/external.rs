@@ -7,8 +7,22 @@
 //!   servo packet `FF FF ID LEN ...`) and lets it onto the wire in one piece; bytes that make
 //!   no frame pass once nothing more has come for [`STALE_AFTER_NS`].
 //! * [`EmulatedArm`]: the simulated bus and seven servos with external boards attached. Each
-//!   hears the bus as its station does (its own bytes too: the boards' TX and RX are tied, and
-//!   an emulated UART has no echo of its own); time advances in [`EmulatedArm::run_until`].
+//!   hears every other station's bytes, but not its own: on the real boards TX and RX are tied
+//!   and the echo ends 30 us after the byte at the latest ([`ECHO_GRACE_US`]), which no echo
+//!   passed back through an emulator's socket can meet (it comes 100 us and more late, and a
+//!   late echo is taken for another station's bytes). Without it the firmware finds the line
+//!   does not echo, as on a board wired without the tie, and serves it as such. Time advances
+//!   in [`EmulatedArm::run_until`].
+//!
+//!
+//!   A board decides to transmit from the line as it saw it, but its bytes reach the simulated
+//!   wire after the emulator's and the socket's delay, by which time the line may be busy. So a
+//!   board's frame starts only when its own rule for a free line holds on the wire then: the
+//!   Basic's [`BUS_QUIET_BEFORE_SEND_US`] of silence, the Atom's (the bus's master) no byte
+//!   under way. Without it the Basic's requests ran into the Atom's servo polling and were lost.
+//!
+//! [`ECHO_GRACE_US`]: protocol_core::timing::ECHO_GRACE_US
+//! [`BUS_QUIET_BEFORE_SEND_US`]: protocol_core::timing::BUS_QUIET_BEFORE_SEND_US
 
 use protocol_core::BytePort;
 
@@ -60,6 +74,11 @@ impl FrameGate {
             }
         }
         out.extend(self.held.drain(..ready));
+    }
+
+    /// Whether any bytes are held.
+    pub fn holds(&self) -> bool {
+        !self.held.is_empty()
     }
 
     /// When held bytes go stale, if any are held.
@@ -115,6 +134,8 @@ fn frame_extent(bytes: &[u8]) -> Extent {
 #[derive(Clone, Debug)]
 struct ExternalBoard {
     station: StationId,
+    /// Silence its frames wait for on the wire, in ns (see the [module doc](self)).
+    quiet_before_send_ns: u64,
     gate: FrameGate,
     /// What the board's UART receives, waiting to be taken.
     heard: Vec<u8>,
@@ -154,11 +175,13 @@ impl EmulatedArm {
         }
     }
 
-    /// Attaches a board whose bus UART hears its own transmissions, as on both real boards.
-    pub fn attach_board(&mut self) -> BoardId {
-        let station = self.bus.attach(true);
+    /// Attaches a board whose frames wait for `quiet_before_send_us` of silence on the wire; it
+    /// does not hear its own transmissions (see the [module doc](self)).
+    pub fn attach_board(&mut self, quiet_before_send_us: u64) -> BoardId {
+        let station = self.bus.attach(false);
         self.boards.push(ExternalBoard {
             station,
+            quiet_before_send_ns: quiet_before_send_us.saturating_mul(1_000),
             gate: FrameGate::new(),
             heard: Vec::new(),
         });
@@ -193,7 +216,7 @@ impl EmulatedArm {
     pub fn busy(&self) -> bool {
         self.bus.busy()
             || self.servos.next_event_ns().is_some()
-            || self.boards.iter().any(|b| b.gate.next_event_ns().is_some())
+            || self.boards.iter().any(|b| b.gate.holds())
     }
 
     /// Advances virtual time to `t_us`.
@@ -203,8 +226,15 @@ impl EmulatedArm {
         while self.now_ns < target {
             let mut next = target;
             let events = [self.bus.next_event_ns(), self.servos.next_event_ns()];
-            let gates = self.boards.iter().filter_map(|b| b.gate.next_event_ns());
-            for t in events.into_iter().flatten().chain(gates) {
+            // A held frame may go when its board's quiet time on the wire is over (while a
+            // byte is under way, the bus's own events come first).
+            let last_activity = self.bus.last_activity_ns();
+            let now = self.now_ns;
+            let gates = self.boards.iter().filter(|b| b.gate.holds()).flat_map(|b| {
+                let quiet_at = last_activity + b.quiet_before_send_ns;
+                [b.gate.next_event_ns(), (quiet_at > now).then_some(quiet_at)]
+            });
+            for t in events.into_iter().chain(gates).flatten() {
                 next = next.min(t);
             }
             self.step(next.max(self.now_ns + 1));
@@ -222,15 +252,17 @@ impl EmulatedArm {
         }
         self.servos.transmit_due(now_ns, &mut self.bus);
         for board in &mut self.boards {
+            let quiet_ns = now_ns.saturating_sub(self.bus.last_activity_ns());
+            let line_free = !self.bus.busy() && quiet_ns >= board.quiet_before_send_ns;
             let Some(mut port) = self.bus.port(board.station) else {
                 continue;
             };
             while let Some(byte) = port.read_byte() {
                 board.heard.push(byte);
             }
-            self.frame.clear();
-            board.gate.release(now_ns, &mut self.frame);
-            if !self.frame.is_empty() {
+            if line_free {
+                self.frame.clear();
+                board.gate.release(now_ns, &mut self.frame);
                 port.write(&self.frame);
             }
         }
@@ -283,9 +315,9 @@ mod tests {
     }
 
     #[test]
-    fn a_board_hears_its_own_frame_and_the_servo_answer() {
+    fn a_board_hears_the_servo_answer_to_its_frame_and_not_its_echo() {
         let mut arm = EmulatedArm::new(1, 2048);
-        let atom = arm.attach_board();
+        let atom = arm.attach_board(0);
         arm.run_until(100);
         // READ servo 1, present position (0x38), 2 bytes.
         let read = [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE];
@@ -295,10 +327,36 @@ mod tests {
         arm.run_until(2_000);
         let mut heard = Vec::new();
         arm.board_received(atom, &mut heard);
-        assert_eq!(heard.get(..8), Some(&read[..]), "its own echo first");
-        let answer = heard.get(8..).unwrap_or_default();
-        assert_eq!(answer.get(..5), Some(&[0xFF, 0xFF, 0x01, 0x04, 0x00][..]));
-        assert_eq!(answer.get(5..7), Some(&[0x00, 0x08][..]), "position 2048");
+        assert_eq!(heard.get(..5), Some(&[0xFF, 0xFF, 0x01, 0x04, 0x00][..]));
+        assert_eq!(heard.get(5..7), Some(&[0x00, 0x08][..]), "position 2048");
+        assert_eq!(heard.len(), 8, "the answer alone: {heard:02X?}");
         assert!(!arm.busy());
+    }
+
+    #[test]
+    fn a_frame_waits_for_the_boards_quiet_line_on_the_wire() {
+        let mut arm = EmulatedArm::new(1, 2048);
+        let atom = arm.attach_board(0);
+        let basic = arm.attach_board(60);
+        arm.run_until(100);
+        arm.board_sent(atom, &[0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE]);
+        arm.run_until(120);
+        // The Basic's frame arrives while the Atom's packet is on the wire.
+        let get_angles = [0xFE, 0xFE, 0x02, 0x20, 0xFA];
+        arm.board_sent(basic, &get_angles);
+        arm.run_until(3_000);
+        let mut atom_heard = Vec::new();
+        arm.board_received(atom, &mut atom_heard);
+        let answer = [0xFF, 0xFF, 0x01, 0x04, 0x00, 0x00, 0x08, 0xF2];
+        assert_eq!(
+            atom_heard.get(..8),
+            Some(&answer[..]),
+            "the servo's answer, ungarbled"
+        );
+        assert_eq!(
+            atom_heard.get(8..),
+            Some(&get_angles[..]),
+            "then the Basic's frame"
+        );
     }
 }
