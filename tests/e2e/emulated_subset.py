@@ -1,0 +1,101 @@
+"""The pymycobot 4.0.7 subset run against the exact board images on emulated chips
+(tests/emulated.rs starts them with tools/emulate): status, versions, angle and coordinate
+moves, jog and stop, IO, bad input and errors, through the emulated Basic's USB serial.
+
+Not part of the virtual robot's suite (the name does not start with `test_`): the emulator
+reads every GPIO input as 0 and runs slower than a chip, so only what holds there is checked.
+
+    MYCOBOT_PORT=/tmp/emulated python tests/e2e/emulated_subset.py -v
+"""
+
+import time
+import unittest
+
+from robot import RobotTestCase, position_error_mm, wait_until
+from test_bad_input import BAD_REQUESTS
+
+
+class StatusAndVersions(RobotTestCase):
+    def test_powered_on_and_connected(self):
+        self.assertEqual(self.mc.is_power_on(), 1)
+        self.assertEqual(self.mc.is_controller_connected(), 1)
+
+    def test_versions(self):
+        system = self.mc.get_system_version()
+        self.assertIsInstance(system, float, f"get_system_version answered {system!r}")
+        self.assertGreater(system, 0)
+        basic = self.mc.get_basic_version()
+        self.assertIsInstance(basic, float, f"get_basic_version answered {basic!r}")
+        self.assertGreater(basic, 0)
+
+
+class Moves(RobotTestCase):
+    def test_angles_then_coordinates(self):
+        target = [10.0, -20.0, 30.0, 0.0, 15.0, 0.0]
+        self.move_to_angles(target, speed=50)
+        self.assertAnglesClose(self.mc.get_angles(), target)
+        pose = self.mc.get_coords()
+        self.assertIsInstance(pose, list, f"get_coords answered {pose!r}")
+        self.home()
+        self.assertEqual(self.mc.send_coords(pose, 50, 0), 1)
+        arrived = wait_until(
+            lambda: isinstance(c := self.mc.get_coords(), list)
+            and position_error_mm(c, pose) <= 1.0
+            and self.mc.is_moving() == 0,
+            10.0,
+        )
+        self.assertTrue(arrived, f"not at {pose}: at {self.mc.get_coords()}")
+        self.assertPoseClose(self.mc.get_coords(), pose, pos_tol=1.0, rot_tol=0.5)
+        self.assertAnglesClose(self.mc.get_angles(), target, tol=0.5)
+        self.home()
+
+    def test_jog_runs_until_stop(self):
+        self.home()
+        self.assertEqual(self.mc.jog_angle(1, 1, 30), 1)
+        self.assertTrue(wait_until(lambda: self.mc.get_angles()[0] > 3, 3.0), "the jog did not move")
+        self.assertEqual(self.mc.stop(), 1)
+        self.wait_stopped(3.0)
+        stopped = self.mc.get_angles()
+        time.sleep(0.5)
+        self.assertAnglesClose(self.mc.get_angles(), stopped, msg="kept moving after stop")
+        self.assertAnglesClose(stopped[1:], [0] * 5, msg="other joints moved")
+        self.home()
+
+
+class InputsAndOutputs(RobotTestCase):
+    def test_basic_and_atom_pins_are_answered(self):
+        # The emulator has no pins to look at: each command must be taken and answered.
+        self.assertIn(self.mc.get_basic_input(35), (0, 1))
+        self.mc.set_basic_output(2, 1)
+        self.mc.set_basic_output(2, 0)
+        self.mc.set_pin_mode(23, 1)
+        self.mc.set_digital_output(23, 1)
+        self.assertIn(self.mc.get_digital_input(23), (0, 1))
+        self.assertEqual(self.mc.get_error_information(), 0)
+        self.assertEqual(self.mc.is_power_on(), 1, "still answering after the pin commands")
+
+
+class BadInputAndErrors(RobotTestCase):
+    def test_bad_requests_change_nothing(self):
+        self.home()
+        for name, request in BAD_REQUESTS.items():
+            with self.subTest(request=name):
+                reply = self.send_raw(request)
+                self.assertNotEqual(reply, request, f"{name}: the request was echoed")
+        self.mc._serial_port.write(bytes(range(256)))  # garbage on the line
+        time.sleep(0.3)
+        self.assertAnglesClose(self.mc.get_angles(), [0] * 6, msg="the arm moved")
+        self.assertEqual(self.mc.is_power_on(), 1)
+
+    def test_an_out_of_limit_angle_is_refused_with_its_joint(self):
+        self.home()
+        self.mc.clear_error_information()
+        self.send_raw(BAD_REQUESTS["send_angles J5 at 170 deg"])
+        self.assertEqual(self.mc.get_error_information(), 5)
+        self.mc.clear_error_information()
+        self.assertTrue(wait_until(lambda: self.mc.get_error_information() == 0, 2.0))
+        self.assertAnglesClose(self.mc.get_angles(), [0] * 6, msg="the arm moved")
+
+
+if __name__ == "__main__":
+    unittest.main()
