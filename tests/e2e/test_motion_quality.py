@@ -52,6 +52,8 @@ class StopTest(RobotTestCase):
         self.move_to_angles([-120, 0, 0, 0, 0, 0], timeout=8)
         self.assertEqual(self.mc.jog_angle(1, 1, speed), 1)
         time.sleep(1.2)
+        # Up to speed and 20 deg on (later on a busy machine, where the robot runs late).
+        wait_until(lambda: self.mc.get_angles()[0] > -100, 1.0)
         asked = time.monotonic()
         at_stop = self.mc.get_angles()[0]
         self.assertEqual(self.mc.stop(), 1)
