@@ -7,14 +7,16 @@
 //! * **Streams**: fresh mode, send_angles of a smooth sine on all joints at 20, 50 and 100 Hz
 //!   (as mycobot_ros does on every joint state): the lag behind the stream beyond one period,
 //!   the residual after removing the lag (RMS and worst), and whether the stream's end is a
-//!   clean stop at its last target.
+//!   clean stop at its last target. Then 50 Hz streams as a busy host sends them: samples late
+//!   by up to 5, 10 or 20 ms, 10 % or 30 % of them dropped, and bursts (the samples held up by
+//!   a stall of 60, 100 or 200 ms sent back to back): lag, residual and worst error for each.
 //! * **Lines**: send_coords mode 1 and jog_coord at speed 50: the flange's largest distance from
 //!   the straight segment, and its largest turn from the orientation.
 //! * **Arcs**: move_c_coords (0x8C) from the present pose through two more at speed 50 and 100:
 //!   the flange's largest distance from the circle through the three poses, how close it passes
 //!   the middle one, and where it ends.
 //!
-//! `cargo bench --bench motion [stop|stream|line|arc]`. Figures, not pass/fail; targets are printed
+//! `cargo bench --bench motion [stop|stream|irregular|line|arc]` (`stream` includes `irregular`). Figures, not pass/fail; targets are printed
 //! next to them. `MOTION_TRACE=1` also prints each line's distance from its segment over time.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
@@ -166,6 +168,129 @@ fn to_wire(degrees: &[f64; 6]) -> [Centideg; 6] {
     degrees.map(|d| Centideg((d * 100.0).round() as i16))
 }
 
+/// When each sample of a stream arrives (us after the stream's start) and the time on the
+/// sine it carries (s): what the client sent and when it reached the robot.
+type Schedule = Vec<(u64, f64)>;
+
+/// A regular stream: one sample every `period_us` for `duration_us`, each carrying the sine at
+/// the moment it is sent.
+fn regular(period_us: u64, duration_us: u64) -> Schedule {
+    (0..duration_us / period_us)
+        .map(|k| (k * period_us, (k * period_us) as f64 / 1e6))
+        .collect()
+}
+
+/// How well the arm followed a stream: the lag of the sine that fits the shafts best (after a
+/// 1 s start), the residual after removing it (RMS and worst, deg), and at the end how far
+/// the arm rests from the last target (deg) and whether it still moves.
+struct Following {
+    lag_ms: i64,
+    rms_deg: f64,
+    worst_deg: f64,
+    /// The same against what arrived: the samples' targets at their arrival times, joined by
+    /// straight lines, with the lag that fits them best. A stall's missing samples are no
+    /// error of the arm here.
+    sent: (i64, f64, f64),
+    end_deg: f64,
+    moving: bool,
+}
+
+/// Feeds the firmware the stream `schedule` (send_angles at 100 %, fresh mode) and measures
+/// how the shafts followed the sine its samples carry.
+fn follow(schedule: &Schedule) -> Following {
+    let mut robot = booted();
+    move_to(&mut robot, sine(0.0));
+    let start_us = robot.now_us();
+    let duration_us = schedule.last().map_or(0, |(at, _)| *at) + SAMPLE_US;
+    let mut trace: Vec<(f64, [f64; 6])> = Vec::new();
+    let mut samples = schedule.iter().peekable();
+    let mut last_target = sine(0.0);
+    while robot.now_us() < start_us + duration_us {
+        while let Some((_, t)) = samples.next_if(|(at, _)| start_us + at <= robot.now_us()) {
+            last_target = sine(*t);
+            send(
+                &mut robot,
+                &Request::SendAngles {
+                    angles: to_wire(&last_target),
+                    speed: speed(100),
+                },
+            );
+        }
+        robot.run_for(SAMPLE_US);
+        drain(&mut robot);
+        let t = (robot.now_us() - start_us) as f64 / 1e6;
+        trace.push((t, robot.shaft_angles_deg()));
+    }
+    let steady: Vec<&(f64, [f64; 6])> = trace.iter().filter(|(t, _)| *t >= 1.0).collect();
+    let (lag_ms, rms_deg, worst_deg) = best_fit(&steady, sine);
+    let arrived: Vec<(f64, [f64; 6])> = schedule
+        .iter()
+        .map(|(at, t)| (*at as f64 / 1e6, sine(*t)))
+        .collect();
+    let sent = best_fit(&steady, |t| along(&arrived, t));
+    // The end: the stream stops; the arm must come to rest at the last target.
+    robot.run_for(1_500_000);
+    drain(&mut robot);
+    let end = robot.shaft_angles_deg();
+    let end_deg = (0..6)
+        .map(|j| (end[j] - last_target[j]).abs())
+        .fold(0.0, f64::max);
+    Following {
+        lag_ms,
+        rms_deg,
+        worst_deg,
+        sent,
+        end_deg,
+        moving: ask(&mut robot, Request::IsMoving) == Reply::Byte(1),
+    }
+}
+
+/// The lag (ms, 0..400) of `reference` that fits `trace` best, and the residual after removing
+/// it: RMS and worst, deg.
+fn best_fit(trace: &[&(f64, [f64; 6])], reference: impl Fn(f64) -> [f64; 6]) -> (i64, f64, f64) {
+    let fit = |lag_s: f64| -> (f64, f64) {
+        let (mut sum, mut worst, mut n) = (0.0, 0.0f64, 0.0);
+        for (t, q) in trace {
+            let want = reference(t - lag_s);
+            for j in 0..6 {
+                let e = q[j] - want[j];
+                sum += e * e;
+                worst = worst.max(e.abs());
+                n += 1.0;
+            }
+        }
+        ((sum / n).sqrt(), worst)
+    };
+    let lag_ms = best_lag_ms(400, fit);
+    let (rms, worst) = fit(f64::from(lag_ms) / 1e3);
+    (i64::from(lag_ms), rms, worst)
+}
+
+/// The lag, whole ms up to `max_ms`, whose `fit` (RMS, worst) has the smallest RMS.
+fn best_lag_ms(max_ms: u32, fit: impl Fn(f64) -> (f64, f64)) -> u32 {
+    (0..=max_ms)
+        .min_by(|&a, &b| {
+            fit(f64::from(a) / 1e3)
+                .0
+                .total_cmp(&fit(f64::from(b) / 1e3).0)
+        })
+        .unwrap_or(0)
+}
+
+/// Where the straight lines through `points` (time in s, angles, in time order) are at `t`.
+fn along(points: &[(f64, [f64; 6])], t: f64) -> [f64; 6] {
+    let after = points.partition_point(|(at, _)| *at <= t);
+    match (after.checked_sub(1).map(|i| &points[i]), points.get(after)) {
+        (Some((ta, a)), Some((tb, b))) if tb > ta => {
+            let f = (t - ta) / (tb - ta);
+            std::array::from_fn(|j| a[j] + f * (b[j] - a[j]))
+        }
+        (Some((_, a)), _) => *a,
+        (None, Some((_, b))) => *b,
+        (None, None) => [0.0; 6],
+    }
+}
+
 fn streams() {
     println!(
         "== streams, fresh mode, send_angles of a 0.4 Hz sine (target: lag <= 50 ms beyond one \
@@ -173,67 +298,97 @@ fn streams() {
     );
     for rate_hz in [20u64, 50, 100] {
         let period_us = 1_000_000 / rate_hz;
-        let mut robot = booted();
-        move_to(&mut robot, sine(0.0));
-        let start_us = robot.now_us();
-        let duration_us = 8_000_000;
-        let mut trace: Vec<(f64, [f64; 6])> = Vec::new();
-        let mut next_sample_us = start_us;
-        let mut last_target = sine(0.0);
-        while robot.now_us() < start_us + duration_us {
-            if robot.now_us() >= next_sample_us {
-                let t = (robot.now_us() - start_us) as f64 / 1e6;
-                last_target = sine(t);
-                send(
-                    &mut robot,
-                    &Request::SendAngles {
-                        angles: to_wire(&last_target),
-                        speed: speed(100),
-                    },
-                );
-                next_sample_us += period_us;
-            }
-            robot.run_for(SAMPLE_US);
-            drain(&mut robot);
-            let t = (robot.now_us() - start_us) as f64 / 1e6;
-            trace.push((t, robot.shaft_angles_deg()));
-        }
-        // Lag: the shift of the sine that fits the arm best (after a 1 s start).
-        let steady: Vec<&(f64, [f64; 6])> = trace.iter().filter(|(t, _)| *t >= 1.0).collect();
-        let fit = |lag_s: f64| -> (f64, f64) {
-            let (mut sum, mut worst, mut n) = (0.0, 0.0f64, 0.0);
-            for (t, q) in &steady {
-                let want = sine(t - lag_s);
-                for j in 0..6 {
-                    let e = q[j] - want[j];
-                    sum += e * e;
-                    worst = worst.max(e.abs());
-                    n += 1.0;
-                }
-            }
-            ((sum / n).sqrt(), worst)
-        };
-        let best_lag_ms = (0..=400)
-            .min_by(|&a, &b| {
-                fit(f64::from(a) / 1e3)
-                    .0
-                    .total_cmp(&fit(f64::from(b) / 1e3).0)
-            })
-            .unwrap_or(0);
-        let (rms, worst) = fit(f64::from(best_lag_ms) / 1e3);
-        // The end: the stream stops; the arm must come to rest at the last target.
-        robot.run_for(1_500_000);
-        drain(&mut robot);
-        let end = robot.shaft_angles_deg();
-        let end_error = (0..6)
-            .map(|j| (end[j] - last_target[j]).abs())
-            .fold(0.0, f64::max);
-        let moving = ask(&mut robot, Request::IsMoving) == Reply::Byte(1);
+        let f = follow(&regular(period_us, 8_000_000));
         println!(
-            "{rate_hz:>3} Hz: lag {best_lag_ms} ms = period + {} ms, residual {rms:.3} deg RMS, \
-             worst {worst:.2} deg; end {end_error:.2} deg from the last target, {}",
-            best_lag_ms as i64 - (period_us / 1000) as i64,
-            if moving { "still moving" } else { "at rest" }
+            "{rate_hz:>3} Hz: lag {} ms = period + {} ms, residual {:.3} deg RMS, worst {:.2} deg; \
+             end {:.2} deg from the last target, {}",
+            f.lag_ms,
+            f.lag_ms - (period_us / 1000) as i64,
+            f.rms_deg,
+            f.worst_deg,
+            f.end_deg,
+            if f.moving { "still moving" } else { "at rest" }
+        );
+    }
+}
+
+/// A small deterministic random source (xorshift64*), so every run feeds the same streams.
+struct Dice(u64);
+
+impl Dice {
+    /// A number in 0..1.
+    fn roll(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Irregular 50 Hz streams, as a busy host sends them: each sample carries the sine at the time
+/// it was due, but arrives late by up to the jitter, or never (dropped), or after a stall
+/// together with the samples held up behind it (a burst).
+fn irregular_streams() {
+    println!(
+        "== irregular 50 Hz streams (the sine at each sample's due time; residual against that \
+         sine; target: residual <= 0.5 deg, worst <= 2 deg, clean end)"
+    );
+    const PERIOD_US: u64 = 20_000;
+    const DURATION_US: u64 = 8_000_000;
+    let mut cases: Vec<(String, Schedule)> = Vec::new();
+    for jitter_ms in [0u64, 5, 10, 20] {
+        let mut dice = Dice(0x9E37_79B9_7F4A_7C15 ^ jitter_ms);
+        let mut schedule: Schedule = regular(PERIOD_US, DURATION_US)
+            .into_iter()
+            .map(|(at, t)| (at + (dice.roll() * (jitter_ms * 1000) as f64) as u64, t))
+            .collect();
+        schedule.sort_by_key(|(at, _)| *at);
+        cases.push((format!("jitter 0..{jitter_ms} ms late"), schedule));
+    }
+    for percent in [10u32, 30] {
+        let mut dice = Dice(0xD1B5_4A32_D192_ED03 ^ u64::from(percent));
+        let schedule = regular(PERIOD_US, DURATION_US)
+            .into_iter()
+            .filter(|_| dice.roll() * 100.0 >= f64::from(percent))
+            .collect();
+        cases.push((format!("{percent} % dropped"), schedule));
+    }
+    for stall_ms in [60u64, 100, 200] {
+        // Every second the client stalls; the samples due meanwhile go out back to back when
+        // it wakes (the line carries one every 1.3 ms).
+        let schedule = regular(PERIOD_US, DURATION_US)
+            .into_iter()
+            .map(|(at, t)| {
+                let into = at % 1_000_000;
+                let stall_end = 500_000 + stall_ms * 1000;
+                (
+                    if (500_000..stall_end).contains(&into) {
+                        at - into + stall_end
+                    } else {
+                        at
+                    },
+                    t,
+                )
+            })
+            .collect();
+        cases.push((
+            format!("burst after a {stall_ms} ms stall, every 1 s"),
+            schedule,
+        ));
+    }
+    for (name, schedule) in &cases {
+        let f = follow(schedule);
+        println!(
+            "{name:<40} lag {:>3} ms, residual {:.3} deg RMS, worst {:.2} deg; against what \
+             arrived: lag {:>3} ms, {:.3} deg RMS, worst {:.2} deg; end {:.2} deg, {}",
+            f.lag_ms,
+            f.rms_deg,
+            f.worst_deg,
+            f.sent.0,
+            f.sent.1,
+            f.sent.2,
+            f.end_deg,
+            if f.moving { "still moving" } else { "at rest" }
         );
     }
 }
@@ -291,18 +446,12 @@ fn coords_stream() {
         }
         ((sum / steady.len() as f64).sqrt(), worst)
     };
-    let best_lag_ms = (0..=200)
-        .min_by(|&a, &b| {
-            fit(f64::from(a) / 1e3)
-                .0
-                .total_cmp(&fit(f64::from(b) / 1e3).0)
-        })
-        .unwrap_or(0);
-    let (rms, worst) = fit(f64::from(best_lag_ms) / 1e3);
+    let lag_ms = best_lag_ms(200, fit);
+    let (rms, worst) = fit(f64::from(lag_ms) / 1e3);
     println!(
-        " 50 Hz send_coords (40 mm circle at 0.25 Hz): lag {best_lag_ms} ms = period + {} ms, \
+        " 50 Hz send_coords (40 mm circle at 0.25 Hz): lag {lag_ms} ms = period + {} ms, \
          residual {rms:.3} mm RMS, worst {worst:.2} mm",
-        best_lag_ms as i64 - 20
+        lag_ms as i64 - 20
     );
 }
 
@@ -496,6 +645,9 @@ fn main() {
     if want("stream") {
         streams();
         coords_stream();
+    }
+    if want("stream") || only.as_deref() == Some("irregular") {
+        irregular_streams();
     }
     if want("line") {
         lines();

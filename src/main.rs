@@ -117,8 +117,8 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
         });
     }
     if view.is_some() {
-        driver = driver.observe_every(web::PUBLISH_PERIOD, move |served: &ServedRobot| {
-            board.publish(Snapshot::of(&served.robot));
+        driver = driver.observe_every(web::PUBLISH_PERIOD, move |served: &ServedRobot, late| {
+            board.publish(Snapshot::of(&served.robot).ran_late(*late));
         });
     }
     driver.run(&stop)?;

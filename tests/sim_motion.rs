@@ -4,7 +4,7 @@
 
 mod sim_support;
 
-use open_mycobot::sim::{HostLink, RobotConfig};
+use open_mycobot::sim::{HostLink, RobotConfig, VirtualRobot};
 use protocol_core::Frame;
 use protocol_core::command::{ErrorCode, JointId, Reply, Request, cmd};
 use protocol_core::units::Centideg;
@@ -290,4 +290,53 @@ fn a_jog_whose_client_vanished_stops_by_itself() {
     robot.run_for(1_000_000);
     assert_eq!(robot.measured_angles()[0], stopped_at, "still jogging");
     assert_eq!(ask(&mut robot, Request::IsMoving), Reply::Byte(0));
+}
+
+/// Sends joint 1 of a 50 Hz stream ramping at 60 deg/s: its targets `from..to`, each on its
+/// 20 ms beat after `start_us`.
+fn stream_joint1(robot: &mut VirtualRobot, start_us: u64, from: u64, to: u64) {
+    for k in from..to {
+        robot.run_until(start_us + k * 20_000);
+        ack(
+            robot,
+            Request::SendAngles {
+                angles: degrees([1.2 * k as f64, 0.0, 0.0, 0.0, 0.0, 0.0]),
+                speed: speed(100),
+            },
+        );
+    }
+}
+
+#[test]
+fn a_stream_sample_that_comes_late_is_not_taken_for_the_end_of_the_stream() {
+    // A busy host holds its samples up for 120 ms (six periods), then sends the next ones on
+    // time: while it waits, the arm goes on to a halt just past the last target instead of
+    // turning back to it, and then follows the stream on to its end.
+    let mut robot = arm();
+    let start_us = robot.now_us();
+    stream_joint1(&mut robot, start_us, 0, 30);
+    let mut trace = Vec::new();
+    while robot.now_us() < start_us + 36 * 20_000 {
+        robot.run_for(1_000);
+        trace.push(robot.measured_angles()[0].0);
+    }
+    let mut furthest = i16::MIN;
+    for &angle in &trace {
+        furthest = furthest.max(angle);
+        assert!(
+            furthest - angle <= ANGLE_TOLERANCE,
+            "joint 1 turned back from {furthest} to {angle} centideg while the stream was late"
+        );
+    }
+    assert!(
+        furthest >= degrees([1.2 * 29.0; 6])[0].0,
+        "joint 1 stopped short of the last target: {furthest}"
+    );
+    stream_joint1(&mut robot, start_us, 36, 50);
+    wait_until_stopped(&mut robot);
+    assert_angles_near(
+        robot.measured_angles(),
+        degrees([1.2 * 49.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        "the stream's last target",
+    );
 }

@@ -44,8 +44,47 @@ pub const IDLE_TICK: Duration = Duration::from_millis(5);
 pub const ACTIVE_SPELL: Duration = Duration::from_millis(50);
 
 /// If the simulation falls this far behind the wall clock (a slow or overloaded machine, a
-/// stopped process), the debt is forgiven instead of fast-forwarding the arm in one jump.
+/// stopped process), the debt is forgiven instead of fast-forwarding the arm in one jump: the
+/// robot runs late, as a real arm looks to a client whose bytes and answers are held up, and
+/// never makes up the time by moving faster than it can. What was forgiven is counted
+/// ([`Lateness`]).
 pub const MAX_CATCH_UP: Duration = Duration::from_millis(50);
+
+/// How often at most the loop says on stderr that it ran late.
+pub const LATE_REPORT_PERIOD: Duration = Duration::from_secs(1);
+
+/// How late the robot ran behind the wall clock because the machine could not keep up: the
+/// time forgiven beyond [`MAX_CATCH_UP`], counted since the start.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Lateness {
+    /// Wall time the robot's virtual time fell behind in all, microseconds.
+    pub total_us: u64,
+    /// How many times it fell behind.
+    pub stalls: u32,
+    /// The most it fell behind at once, microseconds.
+    pub worst_us: u64,
+}
+
+impl Lateness {
+    /// Notes that `behind_us` of wall time was not run.
+    fn fell_behind(&mut self, behind_us: u64) {
+        self.total_us = self.total_us.saturating_add(behind_us);
+        self.stalls = self.stalls.saturating_add(1);
+        self.worst_us = self.worst_us.max(behind_us);
+    }
+}
+
+impl std::fmt::Display for Lateness {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{:.1} ms in {} stalls, the worst {:.1} ms",
+            self.total_us as f64 / 1e3,
+            self.stalls,
+            self.worst_us as f64 / 1e3
+        )
+    }
+}
 
 /// The robot as the front end sees it: the host end of one serial line, network clients with
 /// a link each, and time.
@@ -136,15 +175,18 @@ impl RealtimeRobot for ServedRobot {
 struct Observer<R> {
     period: Duration,
     next: Instant,
-    look: Box<dyn FnMut(&R) + Send>,
+    look: Look<R>,
 }
+
+/// What an [`Observer`] does when it looks: sees the robot and how late it has run.
+type Look<R> = Box<dyn FnMut(&R, &Lateness) + Send>;
 
 impl<R> Observer<R> {
     /// Looks if it is time; keeps a steady rate, but never makes up for missed turns.
-    fn look_if_due(&mut self, robot: &R) {
+    fn look_if_due(&mut self, robot: &R, late: &Lateness) {
         let now = Instant::now();
         if now >= self.next {
-            (self.look)(robot);
+            (self.look)(robot, late);
             self.next = (self.next + self.period).max(now);
         }
     }
@@ -169,6 +211,9 @@ pub struct RealtimeDriver<R> {
     tcp_links: Vec<(ClientId, HostLink)>,
     pacer: LinePacer,
     observer: Option<Observer<R>>,
+    late: Lateness,
+    /// Told how late the robot ran, at most every [`LATE_REPORT_PERIOD`] while it runs late.
+    report_late: Box<dyn FnMut(&Lateness) + Send>,
 }
 
 impl<R: RealtimeRobot> RealtimeDriver<R> {
@@ -182,16 +227,33 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             tcp_links: Vec::new(),
             pacer: LinePacer::new(HOST_BAUD, WINDOW_BYTES),
             observer: None,
+            late: Lateness::default(),
+            report_late: Box::new(|late| {
+                eprintln!("open-mycobot: the machine is too busy, the robot ran late: {late}");
+            }),
         }
     }
 
-    /// Calls `look` with the robot about every `period` of wall time (not more often; later
-    /// if the loop is busy), after virtual time has caught up. `look` runs on the loop's
-    /// thread: it must be quick and never wait, or the robot's answers are late.
+    /// How late the robot has run so far (see [`Lateness`]).
+    pub fn lateness(&self) -> Lateness {
+        self.late
+    }
+
+    /// Replaces what the loop does when the robot ran late (by default a line on stderr, at
+    /// most every [`LATE_REPORT_PERIOD`]).
+    pub fn on_late(mut self, report: impl FnMut(&Lateness) + Send + 'static) -> Self {
+        self.report_late = Box::new(report);
+        self
+    }
+
+    /// Calls `look` with the robot and how late it has run about every `period` of wall time
+    /// (not more often; later if the loop is busy), after virtual time has caught up. `look`
+    /// runs on the loop's thread: it must be quick and never wait, or the robot's answers are
+    /// late.
     pub fn observe_every(
         mut self,
         period: Duration,
-        look: impl FnMut(&R) + Send + 'static,
+        look: impl FnMut(&R, &Lateness) + Send + 'static,
     ) -> Self {
         self.observer = Some(Observer {
             period,
@@ -229,6 +291,8 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
         let mut wall_sync = Instant::now();
         let mut virtual_at_sync = self.robot.now_us();
         let mut last_traffic: Option<Instant> = None;
+        let mut reported = Lateness::default();
+        let mut next_report = Instant::now();
         let mut input = [0u8; 4096];
         let mut output = Vec::with_capacity(256);
         while !stop.load(Ordering::Relaxed) {
@@ -238,14 +302,21 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             self.wait_for_input(if active { ACTIVE_TICK } else { IDLE_TICK }, !line_full)?;
 
             let mut target_us = virtual_at_sync.saturating_add(micros(wall_sync.elapsed()));
-            if target_us > self.robot.now_us() + micros(MAX_CATCH_UP) {
-                target_us = self.robot.now_us() + micros(MAX_CATCH_UP);
+            let furthest_us = self.robot.now_us() + micros(MAX_CATCH_UP);
+            if target_us > furthest_us {
+                self.late.fell_behind(target_us - furthest_us);
+                target_us = furthest_us;
                 wall_sync = Instant::now();
                 virtual_at_sync = target_us;
             }
             self.robot.run_until(target_us);
             if let Some(observer) = self.observer.as_mut() {
-                observer.look_if_due(&self.robot);
+                observer.look_if_due(&self.robot, &self.late);
+            }
+            if self.late != reported && Instant::now() >= next_report {
+                (self.report_late)(&self.late);
+                reported = self.late;
+                next_report = Instant::now() + LATE_REPORT_PERIOD;
             }
 
             let had_input = self.forward_client_input(&mut input)?;
@@ -557,6 +628,17 @@ mod tests {
         stop: Arc<AtomicBool>,
     }
 
+    impl StallingRobot {
+        /// A robot at time 0 that stops the loop (`stop`) after 50 advances.
+        fn new(stop: &Arc<AtomicBool>) -> Self {
+            Self {
+                now_us: 0,
+                advances_us: Vec::new(),
+                stop: Arc::clone(stop),
+            }
+        }
+    }
+
     impl RealtimeRobot for StallingRobot {
         fn now_us(&self) -> u64 {
             self.now_us
@@ -579,11 +661,7 @@ mod tests {
     #[test]
     fn after_a_stall_the_arm_does_not_jump_ahead_by_more_than_the_catch_up_limit() {
         let stop = Arc::new(AtomicBool::new(false));
-        let robot = StallingRobot {
-            now_us: 0,
-            advances_us: Vec::new(),
-            stop: Arc::clone(&stop),
-        };
+        let robot = StallingRobot::new(&stop);
         let driver = RealtimeDriver::new(robot, PseudoTerminal::open().unwrap(), None);
         let robot = driver.run(&stop).unwrap();
         let largest = robot.advances_us.iter().max().copied().unwrap();
@@ -592,6 +670,41 @@ mod tests {
             "advanced {largest} us at once"
         );
         assert_eq!(robot.advances_us.len(), 50);
+    }
+
+    #[test]
+    fn a_stall_is_counted_as_running_late_and_reported() {
+        let stop = Arc::new(AtomicBool::new(false));
+        let robot = StallingRobot::new(&stop);
+        let reports = Arc::new(std::sync::Mutex::new(Vec::new()));
+        let seen = Arc::new(std::sync::Mutex::new(Lateness::default()));
+        let driver = RealtimeDriver::new(robot, PseudoTerminal::open().unwrap(), None)
+            .on_late({
+                let reports = Arc::clone(&reports);
+                move |late: &Lateness| reports.lock().unwrap().push(*late)
+            })
+            .observe_every(Duration::ZERO, {
+                let seen = Arc::clone(&seen);
+                move |_: &StallingRobot, late: &Lateness| *seen.lock().unwrap() = *late
+            });
+        let start = Instant::now();
+        let robot = driver.run(&stop).unwrap();
+        let wall_us = micros(start.elapsed());
+        // A stall of 150 ms (or more, and others, on a busy machine): at most 50 ms of it was
+        // run, the rest is counted as late and said on the report.
+        let late = *seen.lock().unwrap();
+        assert!(late.stalls >= 1, "{late:?}");
+        assert!(late.total_us >= 100_000, "late by {late}");
+        assert!(
+            !reports.lock().unwrap().is_empty(),
+            "the stall was not reported"
+        );
+        // Virtual time plus what was counted as late is the wall time that passed.
+        assert!(
+            robot.now_us + late.total_us <= wall_us,
+            "{} us run + {late} > {wall_us} us of wall time",
+            robot.now_us
+        );
     }
 
     /// Stands still; lets virtual time follow the wall clock.
@@ -621,7 +734,7 @@ mod tests {
             .observe_every(period, {
                 let looks = Arc::clone(&looks);
                 let stop = Arc::clone(&stop);
-                move |_: &IdleRobot| {
+                move |_: &IdleRobot, _: &Lateness| {
                     let mut looks = looks.lock().unwrap();
                     looks.push(Instant::now());
                     if looks.len() == 10 {

@@ -9,6 +9,7 @@ use kinematics_core::geometry::DH_ALPHA_CENTIDEG;
 use protocol_core::command::{EndType, Pose, ReferenceFrame};
 use protocol_core::units::Centideg;
 
+use crate::host::realtime::Lateness;
 use crate::sim::VirtualRobot;
 
 /// The arm at one instant, as the view draws and reads it out. Small and `Copy`, so the
@@ -36,6 +37,9 @@ pub struct Snapshot {
     pub powered: bool,
     /// Whether the Atom is running a motion.
     pub moving: bool,
+    /// How late the simulation has run behind the wall clock because the machine could not
+    /// keep up (zero in virtual-time runs).
+    pub late: Lateness,
 }
 
 impl Snapshot {
@@ -62,7 +66,13 @@ impl Snapshot {
             led_rgb: robot.atom_io().rgb,
             powered: atom.is_powered(),
             moving: atom.is_moving(),
+            late: Lateness::default(),
         }
+    }
+
+    /// The same snapshot, saying the simulation has run `late`.
+    pub fn ran_late(self, late: Lateness) -> Self {
+        Self { late, ..self }
     }
 
     /// The snapshot as one JSON object, the message the page receives:
@@ -70,8 +80,12 @@ impl Snapshot {
     /// ```json
     /// {"t_s":1.5,"angles_deg":[10,20,-30,15,-25,40],
     ///  "coords":[x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg],"end":"flange","frame":"base",
-    ///  "tool":null,"gripper":50,"led":[255,0,0],"powered":true,"moving":false}
+    ///  "tool":null,"gripper":50,"led":[255,0,0],"powered":true,"moving":false,
+    ///  "late_ms":0,"late_stalls":0}
     /// ```
+    ///
+    /// `late_ms` and `late_stalls`: how much wall time the simulation could not run, and in
+    /// how many stalls ([`Lateness`]).
     pub fn to_json(&self) -> String {
         let mut out = String::with_capacity(256);
         let _ = write!(out, "{{\"t_s\":{}", self.time_us as f64 / 1e6);
@@ -95,8 +109,13 @@ impl Snapshot {
         let (r, g, b) = self.led_rgb;
         let _ = write!(
             out,
-            ",\"gripper\":{},\"led\":[{r},{g},{b}],\"powered\":{},\"moving\":{}}}",
-            self.gripper_percent, self.powered, self.moving
+            ",\"gripper\":{},\"led\":[{r},{g},{b}],\"powered\":{},\"moving\":{},\
+             \"late_ms\":{},\"late_stalls\":{}}}",
+            self.gripper_percent,
+            self.powered,
+            self.moving,
+            self.late.total_us as f64 / 1e3,
+            self.late.stalls
         );
         out
     }
@@ -212,6 +231,11 @@ mod tests {
             led_rgb: (255, 0, 16),
             powered: true,
             moving: false,
+            late: Lateness {
+                total_us: 1_250,
+                stalls: 2,
+                worst_us: 1_000,
+            },
         };
         assert_eq!(
             parse(&snapshot.to_json()),
@@ -226,6 +250,8 @@ mod tests {
                 "led": [255.0, 0.0, 16.0],
                 "powered": true,
                 "moving": false,
+                "late_ms": 1.25,
+                "late_stalls": 2.0,
             }))
         );
     }
@@ -243,6 +269,11 @@ mod tests {
             led_rgb: (0, 0, 0),
             powered: false,
             moving: true,
+            late: Lateness {
+                total_us: u64::MAX,
+                stalls: u32::MAX,
+                worst_us: u64::MAX,
+            },
         };
         let value = parse(&snapshot.to_json());
         assert_eq!(value["angles_deg"][0], json!(-327.68));

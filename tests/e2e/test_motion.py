@@ -202,8 +202,7 @@ class PauseStopTest(RobotTestCase):
         self.assertTrue(wait_until(lambda: self.mc.get_angles()[0] > 3, 2.0), "move did not start")
         self.assertEqual(self.mc.pause(), 1)
         self.assertEqual(self.mc.is_paused(), 1)
-        time.sleep(0.3)  # let it come to rest
-        held = self.mc.get_angles()[0]
+        held = self.wait_stopped()[0]
         time.sleep(0.3)
         self.assertAlmostEqual(self.mc.get_angles()[0], held, delta=0.2, msg="moved while paused")
         self.assertLess(held, 85)

@@ -104,7 +104,7 @@ class GripperParityTest(RobotTestCase):
         self.assertEqual(self.mc.set_gripper_value(100, 30), 1)
         time.sleep(0.4)
         self.assertEqual(self.mc.gripper_stop(), 1)
-        time.sleep(0.3)
+        self.assertTrue(wait_until(lambda: self.mc.is_gripper_moving() == 0, 0.3), "the gripper did not stop")
         stopped = self.mc.get_gripper_value()
         self.assertTrue(5 < stopped < 95, f"stopped at {stopped}")
         time.sleep(2.5)

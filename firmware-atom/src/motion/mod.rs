@@ -8,7 +8,8 @@
 //! * **Streams**: in fresh mode, full targets that arrive within [`STREAM_GAP_MAX_US`] of each
 //!   other (a ROS node sending `send_angles` on every joint state) are followed without
 //!   stopping between them, each reached about one stream period after it arrived; a stream
-//!   that stops ends at its last target.
+//!   that stops (no target for [`STREAM_GAP_MAX_US`]: a late target is not its end) ends at
+//!   its last target.
 //! * **Braking**: stop, pause, jog stop, the jog watchdog and a new move that replaces a
 //!   moving one bring every joint to rest at the servos' full deceleration, all joints along
 //!   the path they were on ([`brake`]); a replacing move starts from rest.
@@ -599,7 +600,7 @@ impl MotionController {
                 period_us: stream_period_us,
                 last_us,
             } => {
-                if stream_ended(now_us, *last_us, *stream_period_us) {
+                if stream_ended(now_us, *last_us) {
                     let cap = settings.config().joint_speed_steps(*speed_percent);
                     let goals = follower.goals_towards(
                         bank,

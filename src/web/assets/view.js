@@ -29,9 +29,12 @@ function showReadout(state) {
   const hex = '#' + state.led.map((c) => c.toString(16).padStart(2, '0')).join('');
   $('led-swatch').style.background = hex;
   $('led').textContent = hex;
-  $('status').textContent = [state.powered ? 'powered on' : 'powered off', state.moving ? 'moving' : 'at rest'].join(
-    ' \u00b7 ',
-  );
+  const status = [state.powered ? 'powered on' : 'powered off', state.moving ? 'moving' : 'at rest'];
+  if (state.late_stalls > 0) {
+    // The machine could not keep the simulation in real time: it ran this much late.
+    status.push(`ran ${state.late_ms.toFixed(0)} ms late (${state.late_stalls} stalls)`);
+  }
+  $('status').textContent = status.join(' \u00b7 ');
 }
 
 function showLink(up) {
@@ -105,7 +108,7 @@ let scheduled = false;
 // Everything in a state message that is read out or drawn, except the time: an arm at rest
 // sends the same key 60 times a second, and then the page does nothing.
 const keyOf = (s) =>
-  JSON.stringify([s.angles_deg, s.coords, s.end, s.frame, s.tool, s.gripper, s.led, s.powered, s.moving]);
+  JSON.stringify([s.angles_deg, s.coords, s.end, s.frame, s.tool, s.gripper, s.led, s.powered, s.moving, s.late_stalls]);
 
 function schedule() {
   if (!scheduled) {
