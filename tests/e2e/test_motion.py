@@ -175,7 +175,9 @@ class QueueTest(RobotTestCase):
         try:
             self.home()
             self.mc.set_fresh_mode(0)
-            self.assertGreaterEqual(self.max_joint1_during(first, second), 39.8, "queue mode skipped a move")
+            # The peak at 40 is passed at low speed; a busy client polls it up to ~100 ms apart,
+            # about a degree below it. Fresh mode preempts below 30.
+            self.assertGreaterEqual(self.max_joint1_during(first, second), 38.5, "queue mode skipped a move")
             self.home()
             self.mc.set_fresh_mode(1)
             self.assertLess(self.max_joint1_during(first, second), 30, "fresh mode did not preempt")
