@@ -8,14 +8,15 @@ import unittest
 import serial
 from pymycobot import MyCobot280, MyCobot280Socket
 
-from robot import PORT, RobotTestCase, arm, wait_until
+from robot import PATIENCE, PORT, RobotTestCase, arm, wait_until
 
 GET_ANGLES = bytes([0xFE, 0xFE, 0x02, 0x20, 0xFA])
 
 
 def read_frame(port, timeout=1.0):
-    """Reads bytes until one complete FE FE LEN .. frame arrived; returns (junk, frame)."""
-    deadline = time.monotonic() + timeout
+    """Reads bytes until one complete FE FE LEN .. frame arrived, for up to `timeout` s
+    (PATIENCE times that on a busy machine); returns (junk, frame)."""
+    deadline = time.monotonic() + timeout * PATIENCE
     buf = b""
     while time.monotonic() < deadline:
         buf += port.read(port.in_waiting or 1)

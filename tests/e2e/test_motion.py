@@ -5,7 +5,7 @@ import math
 import time
 import unittest
 
-from robot import MOVE_TIMEOUT, POS_TOL_MM, RobotTestCase, fk, position_error_mm, rotation_error_deg, wait_until
+from robot import MOVE_TIMEOUT, PATIENCE, POS_TOL_MM, RobotTestCase, fk, position_error_mm, rotation_error_deg, wait_until
 
 POSE_A = [10, 20, -30, 15, -25, 40]
 # A comfortable working pose: elbow bent, wrist away from its singularity.
@@ -101,7 +101,7 @@ class CoordMoveTest(RobotTestCase):
         target = [round(v, 1) for v in target]
         self.assertEqual(self.mc.send_coords(target, 30, 1), 1)
         samples = []
-        deadline = time.monotonic() + MOVE_TIMEOUT
+        deadline = time.monotonic() + MOVE_TIMEOUT * PATIENCE
         while time.monotonic() < deadline:
             c = self.mc.get_coords()
             if isinstance(c, list):
@@ -162,7 +162,7 @@ class QueueTest(RobotTestCase):
         self.assertEqual(self.mc.send_angles(first, 100), 1)
         self.assertEqual(self.mc.send_angles(second, 100), 1)
         highest = 0.0
-        deadline = time.monotonic() + MOVE_TIMEOUT
+        deadline = time.monotonic() + MOVE_TIMEOUT * PATIENCE
         while time.monotonic() < deadline:
             highest = max(highest, self.mc.get_angles()[0])
             if self._within(self.mc.get_angles(), second, 0.2) and self.mc.is_moving() == 0:
@@ -175,7 +175,9 @@ class QueueTest(RobotTestCase):
         try:
             self.home()
             self.mc.set_fresh_mode(0)
-            self.assertGreaterEqual(self.max_joint1_during(first, second), 39.8, "queue mode skipped a move")
+            # The peak at 40 is passed at low speed; a busy client polls it up to ~100 ms apart,
+            # about a degree below it. Fresh mode preempts below 30.
+            self.assertGreaterEqual(self.max_joint1_during(first, second), 38.5, "queue mode skipped a move")
             self.home()
             self.mc.set_fresh_mode(1)
             self.assertLess(self.max_joint1_during(first, second), 30, "fresh mode did not preempt")
