@@ -179,3 +179,60 @@ fn a_new_move_that_reverses_a_fast_jog_brakes_at_the_servos_limit_first() {
         "the new move arrives",
     );
 }
+
+/// A stop brakes a joint whose last state reads were lost (its answers late or garbled, as on
+/// a busy bus or an emulated Atom, so the Atom counts it as not answering for the moment): it
+/// still holds torque and hears the stop, so it must get a stopping goal, not run on to the
+/// jog's end at the joint limit.
+#[test]
+fn a_stop_brakes_a_joint_whose_reads_were_just_lost() {
+    for still_answering in [1u8, 5] {
+        let mut robot = arm();
+        ack(
+            &mut robot,
+            Request::JogAngle {
+                joint: JointId::new(1).expect("joint 1"),
+                direction: Direction::Positive,
+                speed: speed(30),
+            },
+        );
+        robot.run_for(700_000);
+        // Its next answers are garbled: 3 missed state reads in a row and the Atom counts it
+        // lost, with the jog still under way.
+        for id in 1..=7 {
+            if id != still_answering {
+                robot.servo_mut(id).expect("servo").corrupt_next_answers(8);
+            }
+        }
+        robot.run_for(40_000);
+        let at_stop = robot.measured_angles()[0];
+        ack(&mut robot, Request::Stop);
+        robot.run_for(1_000_000);
+        let rest = robot.measured_angles()[0];
+        // 45 deg/s braked at 1000 deg/s^2: about 1 deg after the request, as when it answers
+        // (without the fix it ran on towards 168 deg).
+        assert!(
+            rest.0 - at_stop.0 <= 300,
+            "servo {still_answering} answering: joint 1 ran on after the stop, from {at_stop:?} to {rest:?}"
+        );
+        robot.run_for(500_000);
+        assert_eq!(
+            robot.measured_angles()[0],
+            rest,
+            "joint 1 still moving 1 s after the stop"
+        );
+        let angles = robot.measured_angles();
+        assert_angles_near(
+            [
+                Centideg(0),
+                angles[1],
+                angles[2],
+                angles[3],
+                angles[4],
+                angles[5],
+            ],
+            [Centideg(0); 6],
+            "the other joints stay where they were",
+        );
+    }
+}

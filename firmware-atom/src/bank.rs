@@ -43,6 +43,13 @@ const GOAL_CONFIRM_US: u64 = 30_000;
 /// Distance from its goal within which a servo counts as arrived: 10 steps, under one degree.
 const IN_POSITION_STEPS: i32 = 10;
 
+/// How long a stop still trusts the last state read of a servo whose reads are being lost (its
+/// answers late or garbled: a busy bus, a slow or emulated Atom): it holds torque and goes on
+/// doing what it last did, so a stop extrapolates its last read speed for up to this long.
+/// Half a second: a joint at full speed crosses 75 deg in that time, far more than the loss of
+/// a few reads costs, and an older read says nothing about where the joint is.
+const STALE_STATE_US: u64 = 500_000;
+
 /// What to do when a queued servo operation finishes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Then {
@@ -198,12 +205,70 @@ impl ServoBank {
         position * 1000 + i64::from(self.velocity(j)) * age_us / 1000
     }
 
-    /// True while a joint that answers reports moving.
-    pub fn joints_moving(&self) -> bool {
+    /// True if servo `index` holds torque as far as the Atom knows and its position was read at
+    /// least once, whether or not its latest reads came back: what a stop must brake. A servo
+    /// whose answers are lost still hears the goals (a SYNC WRITE has no answer), and it goes
+    /// on towards its last goal until it gets another one.
+    pub fn holds_torque(&self, index: usize) -> bool {
         self.health
-            .iter()
-            .take(JOINTS)
-            .any(|h| h.answering && h.moving)
+            .get(index)
+            .is_some_and(|h| h.ever_answered && h.torque_on)
+    }
+
+    /// Servo `index`'s speed as a stop must assume it, steps per second: its last read speed
+    /// while it answers ([`Self::velocity`]), and also while its reads are being lost, as long as
+    /// its last read is at most [`STALE_STATE_US`] old and it holds torque (it goes on doing
+    /// what it did); 0 otherwise.
+    pub fn last_known_velocity(&self, index: usize) -> i32 {
+        let Some(h) = self.health.get(index) else {
+            return 0;
+        };
+        if h.answering {
+            return self.velocity(index);
+        }
+        if !self.holds_torque(index) || self.read_age_us(index) > STALE_STATE_US {
+            return 0;
+        }
+        i32::from(h.speed_steps_per_s)
+    }
+
+    /// Where servo `index` is now as a stop must assume it, in thousandths of a step: the
+    /// estimate of [`Self::estimated_millisteps`] while it answers; while its reads are being
+    /// lost, its last read position moved on by [`Self::last_known_velocity`] for the whole time
+    /// since (up to [`STALE_STATE_US`]), but never past its last goal (a servo stops there).
+    pub fn last_known_millisteps(&self, index: usize) -> i64 {
+        let Some(h) = self.health.get(index) else {
+            return 0;
+        };
+        if h.answering {
+            return self.estimated_millisteps(index);
+        }
+        let read = i64::from(h.position.0) * 1000;
+        let age_us = self.read_age_us(index).min(STALE_STATE_US) as i64;
+        let moved = read + i64::from(self.last_known_velocity(index)) * age_us / 1000;
+        match self.last_goal(index) {
+            Some(goal) => {
+                let goal = i64::from(goal.position.0) * 1000;
+                moved.clamp(read.min(goal), read.max(goal))
+            }
+            None => read,
+        }
+    }
+
+    /// Time since servo `index`'s state was last read, microseconds.
+    fn read_age_us(&self, index: usize) -> u64 {
+        self.now_us
+            .saturating_sub(self.read_us.get(index).copied().unwrap_or(0))
+    }
+
+    /// True while a joint that answers reports moving, or one whose latest reads were lost
+    /// reported moving at its last read (up to [`STALE_STATE_US`] ago, holding torque): it is
+    /// most likely still moving, and "is moving" must not say no while it brakes.
+    pub fn joints_moving(&self) -> bool {
+        self.health.iter().take(JOINTS).enumerate().any(|(j, h)| {
+            h.moving
+                && (h.answering || (self.holds_torque(j) && self.read_age_us(j) <= STALE_STATE_US))
+        })
     }
 
     /// True while servo `index` moves: its moving flag, or a goal sent moments ago that its

@@ -45,18 +45,21 @@ impl Braking {
         let config = settings.config();
         let a = i64::from(config.motion.servo_accel_steps_per_s2.max(1));
         let v_max = (0..JOINTS)
-            .map(|j| i64::from(bank.velocity(j)).abs())
+            .map(|j| i64::from(bank.last_known_velocity(j)).abs())
             .max()
             .unwrap_or(0);
         let brake_us = v_max * 1_000_000 / a;
         let mut goals = [None; JOINTS];
-        let present = bank.present_angles(settings);
+        let present: [Centideg; JOINTS] =
+            core::array::from_fn(|j| config.millisteps_to_angle(j, bank.last_known_millisteps(j)));
         let mut rest = present;
         for j in 0..JOINTS {
-            if !bank.enabled(j) {
+            // Every joint that holds torque, including one whose latest reads were lost: it
+            // still hears the stop, and without a goal it would run on to its last one.
+            if !bank.holds_torque(j) {
                 continue;
             }
-            let v = i64::from(bank.velocity(j));
+            let v = i64::from(bank.last_known_velocity(j));
             let stop = rest_steps(bank, j, brake_us);
             let now = present.get(j).copied().unwrap_or_default();
             let mut angle = settings.angle(j, stop);
@@ -107,21 +110,21 @@ impl Braking {
 /// its last read speed: its estimated present position, plus what it covers until the goal
 /// arrives ([`GOAL_LATENCY_US`]) and while braking (`v * brake / 2`).
 fn rest_steps(bank: &ServoBank, index: usize, brake_us: i64) -> Steps {
-    let v = i64::from(bank.velocity(index));
+    let v = i64::from(bank.last_known_velocity(index));
     let travel_millisteps = v * (GOAL_LATENCY_US as i64 + brake_us / 2) / 1000;
-    let stop = (bank.estimated_millisteps(index) + travel_millisteps + 500).div_euclid(1000);
+    let stop = (bank.last_known_millisteps(index) + travel_millisteps + 500).div_euclid(1000);
     Steps(stop.clamp(0, i64::from(STEPS_PER_TURN) - 1) as i16)
 }
 
 /// The goal that stops servo `index` (the gripper, or one joint on its own) at the servos' full
 /// deceleration, where it comes to rest; `None` if it holds no torque.
 pub fn stop_one(bank: &ServoBank, settings: &Settings, index: usize) -> Option<Goal> {
-    if !bank.enabled(index) {
+    if !bank.holds_torque(index) {
         return None;
     }
     let config = settings.config();
     let a = i64::from(config.motion.servo_accel_steps_per_s2.max(1));
-    let v = i64::from(bank.velocity(index));
+    let v = i64::from(bank.last_known_velocity(index));
     let brake_us = v.abs() * 1_000_000 / a;
     Some(Goal {
         position: rest_steps(bank, index, brake_us),
