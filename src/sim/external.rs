@@ -150,6 +150,8 @@ pub struct EmulatedArm {
     boards: Vec<ExternalBoard>,
     heard: Vec<HeardByte>,
     frame: Vec<u8>,
+    /// Instants simulated so far (for the tests: time must not crawl).
+    steps: u64,
 }
 
 /// One of the boards of an [`EmulatedArm`], in the order they were attached.
@@ -172,6 +174,7 @@ impl EmulatedArm {
             boards: Vec::new(),
             heard: Vec::new(),
             frame: Vec::new(),
+            steps: 0,
         }
     }
 
@@ -226,18 +229,23 @@ impl EmulatedArm {
         while self.now_ns < target {
             let mut next = target;
             let events = [self.bus.next_event_ns(), self.servos.next_event_ns()];
-            // A held frame may go when its board's quiet time on the wire is over (while a
-            // byte is under way, the bus's own events come first).
+            // A held frame may go when its board's quiet time on the wire is over, or when it
+            // goes stale. Only instants still ahead count: one already past waits for the line
+            // to be free, and that happens at a bus event (stepping to a past instant would
+            // crawl one nanosecond at a time while the line stays busy).
             let last_activity = self.bus.last_activity_ns();
-            let now = self.now_ns;
             let gates = self.boards.iter().filter(|b| b.gate.holds()).flat_map(|b| {
-                let quiet_at = last_activity + b.quiet_before_send_ns;
-                [b.gate.next_event_ns(), (quiet_at > now).then_some(quiet_at)]
+                [
+                    b.gate.next_event_ns(),
+                    Some(last_activity + b.quiet_before_send_ns),
+                ]
             });
             for t in events.into_iter().chain(gates).flatten() {
-                next = next.min(t);
+                if t > self.now_ns {
+                    next = next.min(t);
+                }
             }
-            self.step(next.max(self.now_ns + 1));
+            self.step(next);
         }
     }
 
@@ -245,6 +253,7 @@ impl EmulatedArm {
     /// frames start.
     fn step(&mut self, now_ns: u64) {
         self.now_ns = now_ns;
+        self.steps += 1;
         self.bus.deliver(now_ns);
         self.bus.take_heard(&mut self.heard);
         for heard in self.heard.drain(..) {
@@ -331,6 +340,24 @@ mod tests {
         assert_eq!(heard.get(5..7), Some(&[0x00, 0x08][..]), "position 2048");
         assert_eq!(heard.len(), 8, "the answer alone: {heard:02X?}");
         assert!(!arm.busy());
+    }
+
+    #[test]
+    fn a_frame_held_while_the_line_stays_busy_costs_no_extra_steps() {
+        let mut arm = EmulatedArm::new(1, 2048);
+        let atom = arm.attach_board(0);
+        let basic = arm.attach_board(60);
+        // The Basic's frame goes stale while the Atom keeps the line busy with 40 us gaps.
+        arm.board_sent(basic, &[0xFE, 0xFE, 0x02]);
+        let ping = [0xFF, 0xFF, 0x09, 0x02, 0x01, 0xF3]; // no servo 9: nobody answers
+        let mut t = 0;
+        while t < STALE_AFTER_NS / 1_000 + 2_000 {
+            arm.board_sent(atom, &ping);
+            t += 100; // 60 us of packet, 40 us of gap
+            arm.run_until(t);
+        }
+        let steps_per_us = arm.steps as f64 / t as f64;
+        assert!(steps_per_us < 1.0, "{steps_per_us} steps per us");
     }
 
     #[test]
