@@ -54,14 +54,7 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
             TcpServer::bind(addr).map_err(|e| format!("cannot listen on {addr}: {e}"))
         })
         .transpose()?;
-    let link = cli
-        .pty_link
-        .as_deref()
-        .map(|path| {
-            PtyLink::create(path, pty.slave_path())
-                .map_err(|e| format!("cannot create the link {}: {e}", path.display()))
-        })
-        .transpose()?;
+    let link = pty_link(cli, &pty)?;
 
     let board = Arc::new(StateBoard::new());
     let view = if cli.no_web {
@@ -156,14 +149,7 @@ fn serve_emulated(
         "Atom's host UART"
     };
     let front = Chardev::connect(front_name, host, CONNECT_TIMEOUT)?;
-    let link = cli
-        .pty_link
-        .as_deref()
-        .map(|path| {
-            PtyLink::create(path, pty.slave_path())
-                .map_err(|e| format!("cannot create the link {}: {e}", path.display()))
-        })
-        .transpose()?;
+    let link = pty_link(cli, &pty)?;
     let mut out = std::io::stdout().lock();
     let boards = if cli.emulated_basic.is_some() {
         "the emulated Basic and Atom"
@@ -195,4 +181,15 @@ fn serve_emulated(
     drop(link);
     let _ = writeln!(std::io::stdout(), "stopped");
     Ok(())
+}
+
+/// The `--pty-link` symlink to the pseudo-terminal, if asked for.
+fn pty_link(cli: &Cli, pty: &PseudoTerminal) -> Result<Option<PtyLink>, String> {
+    cli.pty_link
+        .as_deref()
+        .map(|path| {
+            PtyLink::create(path, pty.slave_path())
+                .map_err(|e| format!("cannot create the link {}: {e}", path.display()))
+        })
+        .transpose()
 }
