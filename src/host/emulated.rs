@@ -116,11 +116,6 @@ impl EmulatedBoards {
             scratch: Vec::new(),
         }
     }
-
-    /// The bus and servos.
-    pub fn arm(&self) -> &EmulatedArm {
-        &self.arm
-    }
 }
 
 impl RealtimeRobot for EmulatedBoards {

@@ -210,11 +210,6 @@ impl EmulatedArm {
         }
     }
 
-    /// The servo whose id is `id`.
-    pub fn servo(&self, id: u8) -> Option<&SimServo> {
-        self.servos.get(id)
-    }
-
     /// Whether anything is under way on the bus: a byte, an answer due, held bytes.
     pub fn busy(&self) -> bool {
         self.bus.busy()
