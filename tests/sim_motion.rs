@@ -266,16 +266,8 @@ fn powering_on_after_hand_posing_holds_the_new_pose() {
 
 #[test]
 fn a_jog_whose_client_vanished_stops_by_itself() {
-    use protocol_core::command::Direction;
     let mut robot = arm();
-    ack(
-        &mut robot,
-        Request::JogAngle {
-            joint: JointId::new(1).expect("joint 1"),
-            direction: Direction::Positive,
-            speed: speed(20),
-        },
-    );
+    jog_joint_1(&mut robot, 20);
     robot.run_for(500_000);
     let moving_at = robot.measured_angles()[0];
     assert!(moving_at.0 > 0, "the jog started");

@@ -4,7 +4,7 @@
 mod sim_support;
 
 use open_mycobot::sim::VirtualRobot;
-use protocol_core::command::{Direction, JointId, Pose, Reply, Request, RpyAxis};
+use protocol_core::command::{Direction, Pose, Reply, Request, RpyAxis};
 use protocol_core::units::Centideg;
 use sim_support::*;
 
@@ -22,14 +22,7 @@ fn joint1_trace(robot: &mut VirtualRobot, duration_us: u64) -> Vec<i16> {
 /// on the joint only slows down in the same direction and comes to rest.
 fn brakes_without_reversing(stop: Request, speed_percent: u8) {
     let mut robot = arm();
-    ack(
-        &mut robot,
-        Request::JogAngle {
-            joint: JointId::new(1).expect("joint 1"),
-            direction: Direction::Positive,
-            speed: speed(speed_percent),
-        },
-    );
+    jog_joint_1(&mut robot, speed_percent);
     robot.run_for(800_000);
     let at_stop = robot.measured_angles()[0];
     assert!(
@@ -146,14 +139,7 @@ fn a_new_move_that_reverses_a_fast_jog_brakes_at_the_servos_limit_first() {
         },
     );
     wait_until_stopped(&mut robot);
-    ack(
-        &mut robot,
-        Request::JogAngle {
-            joint: JointId::new(1).expect("joint 1"),
-            direction: Direction::Positive,
-            speed: speed(100),
-        },
-    );
+    jog_joint_1(&mut robot, 100);
     robot.run_for(1_200_000);
     let at_command = robot.measured_angles()[0];
     ack(
@@ -188,14 +174,7 @@ fn a_new_move_that_reverses_a_fast_jog_brakes_at_the_servos_limit_first() {
 fn a_stop_brakes_a_joint_whose_reads_were_just_lost() {
     for still_answering in [1u8, 5] {
         let mut robot = arm();
-        ack(
-            &mut robot,
-            Request::JogAngle {
-                joint: JointId::new(1).expect("joint 1"),
-                direction: Direction::Positive,
-                speed: speed(30),
-            },
-        );
+        jog_joint_1(&mut robot, 30);
         robot.run_for(700_000);
         // Its next answers are garbled: 3 missed state reads in a row and the Atom counts it
         // lost, with the jog still under way.

@@ -3,7 +3,7 @@
 #![allow(dead_code)]
 
 use open_mycobot::sim::{HostLink, RobotConfig, VirtualRobot};
-use protocol_core::command::{Reply, Request, ServoId};
+use protocol_core::command::{Direction, JointId, Reply, Request, ServoId};
 use protocol_core::units::{Centideg, SpeedPercent, Steps};
 use protocol_core::{Frame, FrameDecoder};
 
@@ -59,6 +59,20 @@ pub fn ask_on(robot: &mut VirtualRobot, link: HostLink, request: Request) -> Rep
 pub fn ack(robot: &mut VirtualRobot, request: Request) {
     let reply = ask(robot, request.clone());
     assert_eq!(reply, Reply::Ack, "reply to {request:?}");
+}
+
+/// Starts joint 1 jogging in the positive direction at `percent` (0x30) and checks it is taken.
+pub fn jog_joint_1(robot: &mut VirtualRobot, percent: u8) {
+    let joint = JointId::new(1).expect("joint 1");
+    let direction = Direction::Positive;
+    ack(
+        robot,
+        Request::JogAngle {
+            joint,
+            direction,
+            speed: speed(percent),
+        },
+    );
 }
 
 /// The arm's reported joint angles (0x20).
