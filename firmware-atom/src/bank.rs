@@ -197,12 +197,18 @@ impl ServoBank {
     /// Where joint `j` is now, in thousandths of a step: its last read position moved on by
     /// its last read speed for the time since (the reads of a round are a few ms apart).
     pub fn estimated_millisteps(&self, j: usize) -> i64 {
-        let position = self.health.get(j).map_or(0, |h| i64::from(h.position.0));
-        let age_us = self
-            .now_us
-            .saturating_sub(self.read_us.get(j).copied().unwrap_or(0))
-            .min(20_000) as i64;
-        position * 1000 + i64::from(self.velocity(j)) * age_us / 1000
+        self.extrapolated_millisteps(j, self.velocity(j), 20_000)
+    }
+
+    /// Servo `index`'s last read position moved on at `speed` steps/s for the time since that
+    /// read, at most `max_age_us`, in thousandths of a step.
+    fn extrapolated_millisteps(&self, index: usize, speed: i32, max_age_us: u64) -> i64 {
+        let position = self
+            .health
+            .get(index)
+            .map_or(0, |h| i64::from(h.position.0));
+        let age_us = self.read_age_us(index).min(max_age_us) as i64;
+        position * 1000 + i64::from(speed) * age_us / 1000
     }
 
     /// True if servo `index` holds torque as far as the Atom knows and its position was read at
@@ -244,8 +250,8 @@ impl ServoBank {
             return self.estimated_millisteps(index);
         }
         let read = i64::from(h.position.0) * 1000;
-        let age_us = self.read_age_us(index).min(STALE_STATE_US) as i64;
-        let moved = read + i64::from(self.last_known_velocity(index)) * age_us / 1000;
+        let moved =
+            self.extrapolated_millisteps(index, self.last_known_velocity(index), STALE_STATE_US);
         match self.last_goal(index) {
             Some(goal) => {
                 let goal = i64::from(goal.position.0) * 1000;
