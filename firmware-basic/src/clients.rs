@@ -23,10 +23,11 @@
 use heapless::Deque;
 use protocol_core::BytePort;
 
-use crate::Basic;
+use crate::basic::Basic;
 use crate::host_link::{HOST_WRITE_CHUNK, LinkKind};
 use crate::io::BasicIo;
-use crate::router::{HostPorts, LinkId, MAX_HOST_LINKS};
+use crate::request::{LinkId, MAX_HOST_LINKS};
+use crate::router::HostPorts;
 
 /// Network clients served at once: every host link but the USB one.
 pub const MAX_NETWORK_CLIENTS: usize = MAX_HOST_LINKS - 1;

@@ -39,7 +39,7 @@ use protocol_core::listener::{Echo, Heard, Listener};
 use protocol_core::{BytePort, Frame, timing};
 
 use crate::config::BasicConfig;
-use crate::router::Client;
+use crate::request::{Origin, Request};
 /// Bytes received further apart than this had silence between them (a new transmission
 /// began), in microseconds: one byte time and the reaction time.
 const BURST_GAP_US: u64 = timing::wire_time_us(1, timing::BUS_BAUD) + REACTION_US;
@@ -82,26 +82,6 @@ pub const LATE_REPLY_WINDOW_US: u64 = timing::HOST_REPLY_DEADLINE_US;
 /// Requests given up on whose late replies are recognised: more than a client's deadline's
 /// worth of timeouts of the Basic's own requests (50 ms each) would be needed to push one out.
 pub const MAX_LATE: usize = 8;
-
-/// Who asked for a request, and so where its reply goes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Origin {
-    /// A client on a host link: the reply goes to that client.
-    Host(Client),
-    /// The Basic's boot power-on (0x10): the reply is consumed.
-    PowerOn,
-    /// The Basic's liveness probe (0x12): the reply is consumed.
-    Probe,
-}
-
-/// A request to the Atom.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub(crate) struct Request {
-    pub(crate) frame: Frame,
-    pub(crate) origin: Origin,
-    /// When it arrived (or was made), in microseconds.
-    pub(crate) queued_us: u64,
-}
 
 /// What happened to a request, for the caller to act on.
 #[derive(Debug, PartialEq, Eq)]
@@ -581,7 +561,7 @@ mod tests {
             origin,
             queued_us: 0,
         };
-        let Some(client) = crate::router::Router::new().client(crate::router::LinkId::USB) else {
+        let Some(client) = crate::router::Router::new().client(crate::request::LinkId::USB) else {
             panic!("the USB link is always open");
         };
         assert!(!may_resend(&request(Origin::Host(client))));

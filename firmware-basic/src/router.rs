@@ -27,14 +27,9 @@
 use heapless::{Deque, Vec};
 use protocol_core::{BytePort, Frame};
 
-use crate::forwarder::{Origin, Request};
 use crate::host_link::{HostFrames, HostLink, LinkKind};
+use crate::request::{Client, Delivery, LinkId, MAX_HOST_LINKS, Origin, Request};
 use crate::wifi::{Captured, SetTextCapture, SetTextEnd};
-
-/// Most host links open at once, the USB link included: the USB serial and seven network
-/// clients. An ESP32's network stack serves about ten sockets (one listens); every link costs
-/// about 2.5 KiB of RAM (its listener, request queue and output queue: a `Basic` is 20 KiB).
-pub const MAX_HOST_LINKS: usize = 8;
 
 /// Requests one link may have waiting for the bus. pymycobot sends one request at a time and
 /// waits for its reply; 16 absorb a client that pipelines a burst (at 115200 a request arrives
@@ -42,30 +37,6 @@ pub const MAX_HOST_LINKS: usize = 8;
 /// fifty pipelined `get_angles` are all answered. Staleness is bounded by the client's
 /// deadline ([`LinkKind::client_deadline_us`]), not by the depth.
 pub const LINK_QUEUE_DEPTH: usize = 16;
-
-/// One of the Basic's host links: an index into its table of [`MAX_HOST_LINKS`] links.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct LinkId(u8);
-
-impl LinkId {
-    /// The USB serial: always open, [`LinkKind::Serial`].
-    pub const USB: Self = Self(0);
-
-    /// The link at `index` in the table, if there is such a slot.
-    pub const fn from_index(index: usize) -> Option<Self> {
-        if index < MAX_HOST_LINKS {
-            // Cannot truncate: index < MAX_HOST_LINKS <= 255.
-            Some(Self(index as u8))
-        } else {
-            None
-        }
-    }
-
-    /// The link's index in the table, below [`MAX_HOST_LINKS`].
-    pub const fn index(self) -> usize {
-        self.0 as usize
-    }
-}
 
 /// `Basic::open_link` found every link in use ([`MAX_HOST_LINKS`]); the client is turned away.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -107,25 +78,6 @@ impl<P: BytePort> HostPorts for P {
     fn tx_idle_on(&self, link: LinkId) -> bool {
         link != LinkId::USB || self.tx_idle()
     }
-}
-
-/// Who asked for a request: one client on one link. A link's id is reused by later clients;
-/// the session tells them apart.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Client {
-    pub(crate) link: LinkId,
-    session: u16,
-}
-
-/// What became of a reply for a client.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Delivery {
-    /// Queued for the client.
-    Queued,
-    /// The client's output queue was full: dropped.
-    NoRoom,
-    /// The client has gone: dropped.
-    Gone,
 }
 
 /// A request waiting for its turn on the bus.
@@ -225,17 +177,14 @@ impl Router {
     /// The client now on `link`, if it is open.
     pub(crate) fn client(&self, link: LinkId) -> Option<Client> {
         let slot = self.slots.get(link.index()).filter(|s| s.open)?;
-        Some(Client {
-            link,
-            session: slot.session,
-        })
+        Some(Client::new(link, slot.session))
     }
 
     /// The open link of `client`, if the client is still there.
     fn link_of(&mut self, client: Client) -> Option<&mut HostLink> {
         self.slots
             .get_mut(client.link.index())
-            .filter(|s| s.open && s.session == client.session)
+            .filter(|s| s.open && s.session == client.session())
             .map(|s| &mut s.link)
     }
 
@@ -314,7 +263,7 @@ impl Router {
         match self
             .slots
             .get_mut(client.link.index())
-            .filter(|s| s.open && s.session == client.session)
+            .filter(|s| s.open && s.session == client.session())
         {
             Some(slot) => slot
                 .waiting
@@ -357,10 +306,7 @@ impl Router {
             if !slot.open {
                 continue;
             }
-            let client = Client {
-                link,
-                session: slot.session,
-            };
+            let client = Client::new(link, slot.session);
             let request = |waiting: Waiting| Request {
                 frame: waiting.frame,
                 origin: Origin::Host(client),

@@ -17,9 +17,9 @@ use protocol_core::Frame;
 use protocol_core::command::cmd;
 
 use crate::config::BasicConfig;
-use crate::forwarder::{Event, Origin, Request};
+use crate::forwarder::Event;
 use crate::io::Buttons;
-use crate::router::{Client, Delivery};
+use crate::request::{Client, Delivery, Origin, Request};
 use crate::status::{AtomLink, BasicError, BasicStatus};
 
 /// What the Basic still has to do about the Atom's power.

@@ -1,0 +1,480 @@
+//! The Basic's transponder as one value: [`Basic`] owns the parts (the host links' router,
+//! the bus forwarder, the transparent pipe, the supervisor, the Wi-Fi) and its
+//! [`Basic::poll`] runs them in order: read the bus, read the host links, write waiting Wi-Fi
+//! settings, forward or pass raw bytes, flush the host links. See the [crate doc](crate) for
+//! what a client sees.
+
+use heapless::Deque;
+use protocol_core::command::{Reply, cmd, is_basic_local};
+use protocol_core::listener::{Listener, ListenerConfig};
+use protocol_core::{BytePort, Frame};
+
+use crate::config::{BasicConfig, EchoMode};
+use crate::forwarder::{Event, Forwarder};
+use crate::host_link::{HOST_READ_BUDGET, HostFrames, LinkKind};
+use crate::io::BasicIo;
+use crate::local;
+use crate::request::{Client, LinkId, MAX_HOST_LINKS};
+use crate::router::{HostPorts, LinksFull, Router};
+use crate::status::{BasicError, BasicStatus, TransponderMode};
+use crate::supervisor::Supervisor;
+use crate::transparent::{Intercepted, Transparent};
+use crate::wifi::{self, SetTextEnd, Wifi, WifiStatus};
+
+/// Most bus bytes taken per poll: a poll stays short, and 256 bytes is 2.5 ms of bus time,
+/// far more than arrives between two polls of a board's loop.
+pub const BUS_READ_BUDGET: usize = 256;
+
+/// Longest a Wi-Fi settings change waits for a quiet bus before it is written to flash anyway,
+/// in microseconds. The bus is quiet again within an exchange with the Atom (about 1 ms); only
+/// a silent Atom keeps it busy longer (up to [`BasicConfig::reply_timeout_us`]), and the
+/// client's answer must still come within pymycobot's 50 ms read.
+pub const WIFI_WRITE_WAIT_US: u64 = 20_000;
+
+/// How the Basic hears the bus: host frames (the Atom's replies) and every byte that is not its
+/// own echo (transparent mode passes them on, and they show a reply that began garbled);
+/// servo packets are none of its business.
+pub(crate) fn bus_listener(echo: EchoMode) -> Listener {
+    Listener::new(
+        ListenerConfig::new()
+            .with_packets(false)
+            .with_bytes(true)
+            .with_echo(echo),
+    )
+}
+
+/// What the bus carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Mode {
+    /// Host frames, one request at a time, for every link.
+    Framed,
+    /// Raw bytes between the bus and `owner`, the link that switched (once the request that
+    /// was on the bus then has been answered).
+    Transparent { owner: LinkId },
+}
+
+/// A Wi-Fi settings change waiting for a quiet bus.
+#[derive(Debug)]
+struct WifiWrite {
+    /// Who asked: the answer goes to this client only.
+    client: Client,
+    /// When it arrived, microseconds.
+    since_us: u64,
+    /// What to do.
+    work: WifiWork,
+}
+
+/// A change of the Wi-Fi settings.
+#[derive(Debug)]
+enum WifiWork {
+    /// 0xB2, or 0xB0 with the text framed.
+    Frame(Frame),
+    /// The end of a link's bare 0xB0 text.
+    Text(SetTextEnd),
+}
+
+/// The Basic's transponder: one per board, polled forever.
+#[derive(Debug)]
+pub struct Basic {
+    config: BasicConfig,
+    mode: Mode,
+    router: Router,
+    /// The bus as the Basic hears it, lent to the forwarder or the transparent pipe.
+    bus: Listener,
+    forwarder: Forwarder,
+    transparent: Transparent,
+    supervisor: Supervisor,
+    /// The first poll (the Basic's boot) has happened.
+    booted: bool,
+    /// The Wi-Fi, on a board that lends a settings store (from the first poll on).
+    wifi: Option<Wifi>,
+    /// Wi-Fi settings changes waiting for a quiet bus (at most one per link: a client waits
+    /// for its answer).
+    wifi_writes: Deque<WifiWrite, MAX_HOST_LINKS>,
+}
+
+impl Basic {
+    /// A transponder that has just been powered up, with only its USB link open. `config`
+    /// should have passed [`BasicConfig::validate`]; an invalid one still never panics (0 send
+    /// attempts act as 1).
+    pub fn new(config: BasicConfig) -> Self {
+        Self {
+            config,
+            mode: Mode::Framed,
+            router: Router::new(),
+            bus: bus_listener(config.echo),
+            forwarder: Forwarder::new(),
+            transparent: Transparent::default(),
+            supervisor: Supervisor::new(&config),
+            booted: false,
+            wifi: None,
+            wifi_writes: Deque::new(),
+        }
+    }
+
+    /// The Wi-Fi (settings and station), on a board that lends a settings store
+    /// ([`BasicIo::wifi_store`]), from the first poll on.
+    pub fn wifi(&self) -> Option<&Wifi> {
+        self.wifi.as_ref()
+    }
+
+    /// The Wi-Fi, for the board's network layer: it feeds the station the driver's events
+    /// ([`Wifi::on_event`]) and carries out its actions ([`Wifi::poll`]).
+    pub fn wifi_mut(&mut self) -> Option<&mut Wifi> {
+        self.wifi.as_mut()
+    }
+
+    /// What the LCD shows about Wi-Fi, with `clients` network clients connected; `None` on a
+    /// board without Wi-Fi.
+    pub fn wifi_status(&self, clients: u8) -> Option<WifiStatus> {
+        self.wifi.as_ref().map(|w| w.status(clients))
+    }
+
+    /// Opens a host link for a new client of `kind` (a TCP connection: [`LinkKind::Network`]),
+    /// with its own framer, queue and turn on the bus. [`LinksFull`] if [`MAX_HOST_LINKS`]
+    /// links are open: the transport turns the client away.
+    pub fn open_link(&mut self, kind: LinkKind) -> Result<LinkId, LinksFull> {
+        self.router.open(kind)
+    }
+
+    /// Closes `link`, whose client has gone: its partial frame, waiting requests and queued
+    /// output are dropped, and the reply to its request on the bus (if any) will be too. If it
+    /// had switched the bus to transparent mode, the bus is framed again. Closing the USB link
+    /// (always open) starts it afresh.
+    pub fn close_link(&mut self, link: LinkId) {
+        self.router.close(link);
+        if self.mode == (Mode::Transparent { owner: link }) {
+            self.leave_transparent();
+        }
+    }
+
+    /// True if `link` is open.
+    pub fn link_open(&self, link: LinkId) -> bool {
+        self.router.is_open(link)
+    }
+
+    /// Does all pending work at time `now_us` (monotonic microseconds): reads what arrived on
+    /// the host links and the bus, answers or forwards, checks deadlines. Never blocks; call it
+    /// often (every few microseconds of bus time) and whenever bytes arrive. `hosts` are the
+    /// host links' ports: a single [`BytePort`] is the USB link alone.
+    pub fn poll<H: HostPorts, B: BytePort, I: BasicIo>(
+        &mut self,
+        now_us: u64,
+        hosts: &mut H,
+        bus: &mut B,
+        io: &mut I,
+    ) {
+        if !self.booted {
+            self.booted = true;
+            // Whatever the wire was doing before we booted, give it a quiet time first.
+            self.bus.assume_busy_until(now_us);
+            self.supervisor.boot(now_us, &self.config);
+            self.wifi = io.wifi_store().map(|store| Wifi::start(now_us, store));
+        }
+        self.read_bus(now_us, bus);
+        self.read_hosts(now_us, hosts, io);
+        self.write_wifi_settings(now_us, io);
+        let buttons = io.buttons();
+        match self.mode {
+            Mode::Transparent { owner } if self.forwarder.idle() => {
+                let (supervisor, router) = (&mut self.supervisor, &mut self.router);
+                self.transparent.poll(now_us, bus, &mut self.bus, |b| {
+                    send_raw(router, owner, supervisor, b)
+                });
+            }
+            mode => {
+                let (supervisor, router) = (&mut self.supervisor, &mut self.router);
+                self.forwarder
+                    .on_time(now_us, bus, &mut self.bus, &self.config, |e| {
+                        deliver(now_us, e, supervisor, router)
+                    });
+                // The Basic's own requests only on a framed bus nobody else is using.
+                let idle =
+                    mode == Mode::Framed && self.forwarder.idle() && !self.router.has_requests();
+                let internal = self
+                    .supervisor
+                    .next_internal(now_us, &self.config, buttons, idle);
+                // A settings change waiting for the quiet bus goes first.
+                if mode == Mode::Framed && self.forwarder.idle() && self.wifi_writes.is_empty() {
+                    let (supervisor, router) = (&mut self.supervisor, &mut self.router);
+                    let next = internal.or_else(|| {
+                        // An expired request has no reply to give.
+                        router.next_request(now_us, |expired| {
+                            let _ = supervisor.on_event(now_us, Event::Expired(expired));
+                        })
+                    });
+                    if let Some(request) = next {
+                        self.forwarder.start(request);
+                    }
+                }
+                self.forwarder.try_send(now_us, bus, &mut self.bus);
+            }
+        }
+        self.router.flush(hosts);
+    }
+
+    /// What the LCD shows.
+    pub fn status(&self) -> BasicStatus {
+        BasicStatus {
+            mode: match self.mode {
+                Mode::Framed => TransponderMode::Framed,
+                Mode::Transparent { .. } => TransponderMode::Transparent,
+            },
+            echo_heard: self.bus.echo_heard(),
+            transparent_dropped: self.transparent.dropped,
+            ..self.supervisor.status
+        }
+    }
+
+    fn read_bus<B: BytePort>(&mut self, now_us: u64, bus: &mut B) {
+        for _ in 0..BUS_READ_BUDGET {
+            let Some(byte) = bus.read_byte() else {
+                break;
+            };
+            let (supervisor, router) = (&mut self.supervisor, &mut self.router);
+            match self.mode {
+                Mode::Transparent { owner } if self.forwarder.idle() => {
+                    Transparent::bus_byte(now_us, byte, &mut self.bus, |b| {
+                        send_raw(router, owner, supervisor, b)
+                    });
+                }
+                _ => {
+                    self.forwarder
+                        .on_bus_byte(now_us, byte, &mut self.bus, &self.config, |e| {
+                            deliver(now_us, e, supervisor, router)
+                        });
+                }
+            }
+        }
+    }
+
+    fn read_hosts<H: HostPorts, I: BasicIo>(&mut self, now_us: u64, hosts: &mut H, io: &mut I) {
+        for link in self.router.open_links() {
+            self.read_host(now_us, hosts, link, io);
+        }
+    }
+
+    /// Reads what arrived on `link` (at most [`HOST_READ_BUDGET`] bytes) and acts on it.
+    fn read_host<H: HostPorts, I: BasicIo>(
+        &mut self,
+        now_us: u64,
+        hosts: &mut H,
+        link: LinkId,
+        io: &mut I,
+    ) {
+        for _ in 0..HOST_READ_BUDGET {
+            let mut frames = HostFrames::new();
+            let Some(byte) = self.router.read_byte(now_us, hosts, link, &mut frames) else {
+                break;
+            };
+            if self.is_owner(link) {
+                if let Some(hit) = self.transparent.host_byte(byte) {
+                    self.on_intercepted(link, hit);
+                }
+            } else {
+                for frame in frames.drain(..) {
+                    self.on_host_frame(now_us, link, frame, io);
+                }
+            }
+        }
+        if self.is_owner(link) {
+            let quiet_us = self.router.quiet_for_us(now_us, link);
+            self.transparent.host_quiet(quiet_us);
+        } else {
+            if let Some(end) = self.router.poll_capture(now_us, link) {
+                self.queue_wifi_write(now_us, link, WifiWork::Text(end));
+            }
+            let mut frames = HostFrames::new();
+            self.router.check_gap(now_us, link, &mut frames);
+            for frame in frames.drain(..) {
+                self.on_host_frame(now_us, link, frame, io);
+            }
+        }
+    }
+
+    /// True if `link` switched the bus to transparent mode: its bytes are raw.
+    fn is_owner(&self, link: LinkId) -> bool {
+        self.mode == (Mode::Transparent { owner: link })
+    }
+
+    fn on_host_frame<I: BasicIo>(&mut self, now_us: u64, link: LinkId, frame: Frame, io: &mut I) {
+        if self.is_owner(link) {
+            // A frame completed by the same byte as the one that entered transparent mode:
+            // it is raw data now.
+            for &b in frame.to_bytes().iter() {
+                if let Some(hit) = self.transparent.host_byte(b) {
+                    self.on_intercepted(link, hit);
+                }
+            }
+            return;
+        }
+        let code = frame.cmd();
+        if let Mode::Transparent { .. } = self.mode {
+            // The bus is another client's: the Basic's own commands are still answered (0xC3
+            // says why the rest is not), 0xC2 is that client's to send.
+            if code == cmd::SET_TRANSPONDER_MODE {
+                self.send_frame(link, &Reply::Byte(0).to_frame(code));
+                return;
+            }
+            if !is_basic_local(code) {
+                self.supervisor
+                    .error(BasicError::TransparentElsewhere { cmd: code });
+                return;
+            }
+        }
+        self.supervisor.on_host_request(code);
+        if self.wifi.is_some() && wifi::writes_settings(&frame) {
+            self.queue_wifi_write(now_us, link, WifiWork::Frame(frame));
+            return;
+        }
+        let cx = local::Context {
+            version_x10: self.config.version_x10,
+            mode: self.status().mode,
+            wifi: self.wifi.as_mut(),
+            now_us,
+        };
+        if let Some(answer) = local::answer(&frame, io, cx) {
+            self.send_answer(link, &answer);
+            if answer.capture_text {
+                self.router.start_capture(now_us, link);
+            }
+            if answer.new_mode == Some(TransponderMode::Transparent) && self.mode == Mode::Framed {
+                self.enter_transparent(link);
+            }
+            return;
+        }
+        let Some(client) = self.router.client(link) else {
+            return;
+        };
+        if self.router.push(client, frame, now_us).is_err() {
+            self.supervisor.error(BasicError::QueueFull { cmd: code });
+        }
+    }
+
+    /// Queues the answer to one of the Basic's own commands for `link`, noting what went wrong.
+    fn send_answer(&mut self, link: LinkId, answer: &local::Answer) {
+        let sent = match &answer.reply {
+            local::Reply::Frame(reply) => self.router.send_frame(link, reply),
+            local::Reply::Text(bytes) => self.router.send_bytes(link, bytes),
+        };
+        if !sent {
+            self.supervisor.error(BasicError::HostOverflow);
+        }
+        if let Some(error) = answer.error {
+            self.supervisor.error(error);
+        }
+    }
+
+    /// Keeps a Wi-Fi settings change from `link` until the bus is quiet.
+    fn queue_wifi_write(&mut self, now_us: u64, link: LinkId, work: WifiWork) {
+        let Some(client) = self.router.client(link) else {
+            return;
+        };
+        let code = match &work {
+            WifiWork::Frame(frame) => frame.cmd(),
+            WifiWork::Text(_) => cmd::SET_SSID_PWD,
+        };
+        let write = WifiWrite {
+            client,
+            since_us: now_us,
+            work,
+        };
+        if self.wifi_writes.push_back(write).is_err() {
+            // A link has at most one change waiting unless its client does not wait for its
+            // answers: refuse that one.
+            self.send_frame(link, &Reply::Byte(0).to_frame(code));
+        }
+    }
+
+    /// Writes the waiting Wi-Fi settings changes once no request is on the bus (or they have
+    /// waited [`WIFI_WRITE_WAIT_US`]), and answers each client that asked.
+    fn write_wifi_settings<I: BasicIo>(&mut self, now_us: u64, io: &mut I) {
+        while let Some(front) = self.wifi_writes.front() {
+            let waited = now_us.saturating_sub(front.since_us);
+            if !self.forwarder.idle() && waited < WIFI_WRITE_WAIT_US {
+                return;
+            }
+            let Some(write) = self.wifi_writes.pop_front() else {
+                return;
+            };
+            let answer = match write.work {
+                WifiWork::Frame(frame) => {
+                    let cx = local::Context {
+                        version_x10: self.config.version_x10,
+                        mode: self.status().mode,
+                        wifi: self.wifi.as_mut(),
+                        now_us,
+                    };
+                    local::answer(&frame, io, cx)
+                }
+                WifiWork::Text(end) => local::answer_set_text(end, io, self.wifi.as_mut(), now_us),
+            };
+            // The client may have gone meanwhile (its link closed or reused): then nobody is
+            // answered, but the change stands.
+            if let Some(answer) = answer
+                && self.router.client(write.client.link) == Some(write.client)
+            {
+                self.send_answer(write.client.link, &answer);
+            }
+        }
+    }
+
+    /// Queues `frame` for `link`, noting an overflow.
+    fn send_frame(&mut self, link: LinkId, frame: &Frame) {
+        if !self.router.send_frame(link, frame) {
+            self.supervisor.error(BasicError::HostOverflow);
+        }
+    }
+
+    /// `owner` switched the bus to transparent mode: requests still waiting are dropped (their
+    /// clients would get the raw bytes of the reply otherwise); the one on the bus is answered
+    /// first.
+    fn enter_transparent(&mut self, owner: LinkId) {
+        self.mode = Mode::Transparent { owner };
+        self.router.clear_requests();
+        self.router.reset_framer(owner);
+        self.transparent = Transparent::default();
+    }
+
+    /// Back to framed mode.
+    fn leave_transparent(&mut self) {
+        if let Mode::Transparent { owner } = self.mode {
+            self.router.reset_framer(owner);
+        }
+        self.mode = Mode::Framed;
+        self.transparent = Transparent::default();
+        self.bus.drop_partials();
+    }
+
+    /// Answers a frame the Basic still handles in transparent mode, from the owner `link`.
+    /// Raw traffic still queued for it is dropped so the answer is not lost behind a backlog of
+    /// bus bytes.
+    fn on_intercepted(&mut self, link: LinkId, hit: Intercepted) {
+        self.router.clear_tx(link);
+        let reply = match hit {
+            Intercepted::SetFramed => {
+                self.leave_transparent();
+                Reply::Ack.to_frame(cmd::SET_TRANSPONDER_MODE)
+            }
+            Intercepted::SetTransparent => Reply::Ack.to_frame(cmd::SET_TRANSPONDER_MODE),
+            Intercepted::GetMode => {
+                Reply::Byte(TransponderMode::Transparent as u8).to_frame(cmd::GET_TRANSPONDER_MODE)
+            }
+        };
+        self.send_frame(link, &reply);
+    }
+}
+
+/// Acts on what happened to a request: status for the display, a reply for its client.
+fn deliver(now_us: u64, event: Event, supervisor: &mut Supervisor, router: &mut Router) {
+    if let Some((client, reply)) = supervisor.on_event(now_us, event) {
+        supervisor.on_delivery(router.send_reply(client, &reply));
+    }
+}
+
+/// Queues one raw byte for `link`, noting an overflow.
+fn send_raw(router: &mut Router, link: LinkId, supervisor: &mut Supervisor, byte: u8) {
+    if !router.send_raw(link, byte) {
+        supervisor.error(BasicError::HostOverflow);
+    }
+}
