@@ -200,7 +200,7 @@ impl Basic {
                     let next = internal.or_else(|| {
                         // An expired request has no reply to give.
                         router.next_request(now_us, |expired| {
-                            let _ = supervisor.on_event(now_us, Event::Expired(expired));
+                            supervisor.on_event(now_us, &Event::Expired(expired));
                         })
                     });
                     if let Some(request) = next {
@@ -465,10 +465,14 @@ impl Basic {
     }
 }
 
-/// Acts on what happened to a request: status for the display, a reply for its client.
+/// Acts on what happened to a request: the supervisor watches it (status for the display),
+/// and a reply goes where the router says (the client that asked, or nobody).
 fn deliver(now_us: u64, event: Event, supervisor: &mut Supervisor, router: &mut Router) {
-    if let Some((client, reply)) = supervisor.on_event(now_us, event) {
-        supervisor.on_delivery(router.send_reply(client, &reply));
+    supervisor.on_event(now_us, &event);
+    if let Event::Reply { request, reply } = event
+        && let Some(delivery) = router.deliver(request.origin, &reply)
+    {
+        supervisor.on_delivery(delivery);
     }
 }
 

@@ -561,9 +561,7 @@ mod tests {
             origin,
             queued_us: 0,
         };
-        let Some(client) = crate::router::Router::new().client(crate::request::LinkId::USB) else {
-            panic!("the USB link is always open");
-        };
+        let client = crate::request::Client::new(crate::request::LinkId::USB, 0);
         assert!(!may_resend(&request(Origin::Host(client))));
         assert!(may_resend(&request(Origin::Probe)));
         assert!(may_resend(&request(Origin::PowerOn)));

@@ -332,6 +332,15 @@ impl Router {
         None
     }
 
+    /// Delivers the Atom's `reply` to a request from `origin`: a client's goes to that client
+    /// ([`Self::send_reply`]); the Basic's own requests' replies go to nobody (`None`).
+    pub(crate) fn deliver(&mut self, origin: Origin, reply: &Frame) -> Option<Delivery> {
+        match origin {
+            Origin::Host(client) => Some(self.send_reply(client, reply)),
+            Origin::PowerOn | Origin::Probe => None,
+        }
+    }
+
     /// Queues `reply` for `client`, whole or not at all.
     pub(crate) fn send_reply(&mut self, client: Client, reply: &Frame) -> Delivery {
         match self.link_of(client).map(|link| link.send_frame(reply)) {

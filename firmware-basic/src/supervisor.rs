@@ -1,14 +1,17 @@
 //! Looks after the Atom and keeps the status the LCD shows: makes sure the Atom is powered after
-//! boot, probes it (0x12) when it has been silent for a while, and turns the forwarder's events
-//! into replies for the host and status for the display.
+//! boot, probes it (0x12) when it has been silent for a while, and watches the forwarder's
+//! events and the replies' deliveries for the status. It only observes: where a reply goes is
+//! the router's decision ([`crate::router`]), and its own requests (the probe, the power-on)
+//! go out only when the bus has nothing else to do.
 //!
 //! The boot power-on never cuts a move short. The vendor transponder sends power on (0x10) at
 //! boot, and the Atom answers 0x10 by holding the arm where it is: a move the host started in
 //! the Basic's first second (or before the Basic restarted) would stop halfway. So the Basic
 //! first asks (0x12) and sends 0x10 only if the Atom says it is off, with no host request
-//! having reached the Atom between that answer and the 0x10 (else it asks again). An Atom that is off runs no
-//! motion (it refuses moves while off), so this 0x10 stops nothing. A host power on, power off
-//! or release (0x10, 0x11, 0x13) decides the power itself, and the Basic no longer does.
+//! having reached the Atom between that answer and the 0x10 (else it asks again). An Atom that
+//! is off runs no motion (it refuses moves while off), so this 0x10 stops nothing. A host power
+//! on, power off or release (0x10, 0x11, 0x13) decides the power itself, and the Basic no
+//! longer does.
 //! Button A is the user asking in person: a press (the button going from released to pressed)
 //! sends 0x10 at once, once; a button held, or read as pressed from boot (a stuck button, an
 //! emulator that reads every input as 0), does nothing until it has been released.
@@ -19,7 +22,7 @@ use protocol_core::command::cmd;
 use crate::config::BasicConfig;
 use crate::forwarder::Event;
 use crate::io::Buttons;
-use crate::request::{Client, Delivery, Origin, Request};
+use crate::request::{Delivery, Origin, Request};
 use crate::status::{AtomLink, BasicError, BasicStatus};
 
 /// What the Basic still has to do about the Atom's power.
@@ -192,10 +195,10 @@ impl Supervisor {
         }
     }
 
-    /// Acts on what happened to a request: returns a client's reply with the client to give it
-    /// to ([`Self::on_delivery`] then hears what became of it); an internal request's reply
-    /// goes only into the status.
-    pub(crate) fn on_event(&mut self, now_us: u64, event: Event) -> Option<(Client, Frame)> {
+    /// Watches what happened to a request at `now_us`: what the Atom said goes into the
+    /// status, and the Basic's own questions are settled. Where a client's reply goes is the
+    /// router's business; [`Self::on_delivery`] then hears what became of it.
+    pub(crate) fn on_event(&mut self, now_us: u64, event: &Event) {
         if let (Some(Origin::Host(_)), PowerTask::Ensure { off_seen }) =
             (event.origin(), &mut self.power)
         {
@@ -205,20 +208,15 @@ impl Supervisor {
             *off_seen = false;
         }
         match event {
-            Event::Reply { request, reply } => {
-                self.on_answer(now_us, &request, &reply);
-                if let Origin::Host(client) = request.origin {
-                    return Some((client, reply));
-                }
-            }
+            Event::Reply { request, reply } => self.on_answer(now_us, request, reply),
             // Its client was given up on (and may have asked something else since): the
             // reply goes only into the status.
             Event::Late { request, reply } => {
-                self.on_answer(now_us, &request, &reply);
+                self.on_answer(now_us, request, reply);
                 self.status.late_replies = self.status.late_replies.wrapping_add(1);
             }
             Event::Timeout(request) => {
-                self.on_unanswered(&request);
+                self.on_unanswered(request);
                 let status = &mut self.status;
                 status.atom = AtomLink::Silent;
                 status.timeouts = status.timeouts.wrapping_add(1);
@@ -227,7 +225,7 @@ impl Supervisor {
                 });
             }
             Event::GaveUp(request) => {
-                self.on_unanswered(&request);
+                self.on_unanswered(request);
                 let status = &mut self.status;
                 status.collisions = status.collisions.wrapping_add(1);
                 status.last_error = Some(BasicError::BusCollisions {
@@ -244,10 +242,9 @@ impl Supervisor {
             }
             Event::Unsolicited => {}
         }
-        None
     }
 
-    /// What became of a reply [`Self::on_event`] gave out for a client.
+    /// What became of a client's reply the router was given to deliver.
     pub(crate) fn on_delivery(&mut self, delivery: Delivery) {
         match delivery {
             Delivery::Queued => {
