@@ -4,7 +4,6 @@
 //! settings, forward or pass raw bytes, flush the host links. See the [crate doc](crate) for
 //! what a client sees.
 
-use heapless::Deque;
 use protocol_core::command::{Reply, cmd, is_basic_local};
 use protocol_core::listener::{Listener, ListenerConfig};
 use protocol_core::{BytePort, Frame};
@@ -19,17 +18,11 @@ use crate::router::{HostPorts, LinksFull, Router};
 use crate::status::{BasicError, BasicStatus, TransponderMode};
 use crate::supervisor::Supervisor;
 use crate::transparent::{Intercepted, Transparent};
-use crate::wifi::{self, SetTextEnd, Wifi, WifiStatus};
+use crate::wifi::{self, SettingsChange, SettingsWrites, Wifi, WifiStatus};
 
 /// Most bus bytes taken per poll: a poll stays short, and 256 bytes is 2.5 ms of bus time,
 /// far more than arrives between two polls of a board's loop.
 pub const BUS_READ_BUDGET: usize = 256;
-
-/// Longest a Wi-Fi settings change waits for a quiet bus before it is written to flash anyway,
-/// in microseconds. The bus is quiet again within an exchange with the Atom (about 1 ms); only
-/// a silent Atom keeps it busy longer (up to [`BasicConfig::reply_timeout_us`]), and the
-/// client's answer must still come within pymycobot's 50 ms read.
-pub const WIFI_WRITE_WAIT_US: u64 = 20_000;
 
 /// How the Basic hears the bus: host frames (the Atom's replies) and every byte that is not its
 /// own echo (transparent mode passes them on, and they show a reply that began garbled);
@@ -53,26 +46,6 @@ enum Mode {
     Transparent { owner: LinkId },
 }
 
-/// A Wi-Fi settings change waiting for a quiet bus.
-#[derive(Debug)]
-struct WifiWrite {
-    /// Who asked: the answer goes to this client only.
-    client: Client,
-    /// When it arrived, microseconds.
-    since_us: u64,
-    /// What to do.
-    work: WifiWork,
-}
-
-/// A change of the Wi-Fi settings.
-#[derive(Debug)]
-enum WifiWork {
-    /// 0xB2, or 0xB0 with the text framed.
-    Frame(Frame),
-    /// The end of a link's bare 0xB0 text.
-    Text(SetTextEnd),
-}
-
 /// The Basic's transponder: one per board, polled forever.
 #[derive(Debug)]
 pub struct Basic {
@@ -90,7 +63,7 @@ pub struct Basic {
     wifi: Option<Wifi>,
     /// Wi-Fi settings changes waiting for a quiet bus (at most one per link: a client waits
     /// for its answer).
-    wifi_writes: Deque<WifiWrite, MAX_HOST_LINKS>,
+    wifi_writes: SettingsWrites<Client, MAX_HOST_LINKS>,
 }
 
 impl Basic {
@@ -108,7 +81,7 @@ impl Basic {
             supervisor: Supervisor::new(&config),
             booted: false,
             wifi: None,
-            wifi_writes: Deque::new(),
+            wifi_writes: SettingsWrites::new(),
         }
     }
 
@@ -282,7 +255,7 @@ impl Basic {
             self.transparent.host_quiet(quiet_us);
         } else {
             if let Some(end) = self.router.poll_capture(now_us, link) {
-                self.queue_wifi_write(now_us, link, WifiWork::Text(end));
+                self.queue_wifi_write(now_us, link, SettingsChange::Text(end));
             }
             let mut frames = HostFrames::new();
             self.router.check_gap(now_us, link, &mut frames);
@@ -324,16 +297,10 @@ impl Basic {
         }
         self.supervisor.on_host_request(code);
         if self.wifi.is_some() && wifi::writes_settings(&frame) {
-            self.queue_wifi_write(now_us, link, WifiWork::Frame(frame));
+            self.queue_wifi_write(now_us, link, SettingsChange::Frame(frame));
             return;
         }
-        let cx = local::Context {
-            version_x10: self.config.version_x10,
-            mode: self.status().mode,
-            wifi: self.wifi.as_mut(),
-            now_us,
-        };
-        if let Some(answer) = local::answer(&frame, io, cx) {
+        if let Some(answer) = local::answer(&frame, io, self.local_context(now_us)) {
             self.send_answer(link, &answer);
             if answer.capture_text {
                 self.router.start_capture(now_us, link);
@@ -348,6 +315,16 @@ impl Basic {
         };
         if self.router.push(client, frame, now_us).is_err() {
             self.supervisor.error(BasicError::QueueFull { cmd: code });
+        }
+    }
+
+    /// What the Basic's own commands read or change, at `now_us`.
+    fn local_context(&mut self, now_us: u64) -> local::Context<'_> {
+        local::Context {
+            version_x10: self.config.version_x10,
+            mode: self.status().mode,
+            wifi: self.wifi.as_mut(),
+            now_us,
         }
     }
 
@@ -366,55 +343,37 @@ impl Basic {
     }
 
     /// Keeps a Wi-Fi settings change from `link` until the bus is quiet.
-    fn queue_wifi_write(&mut self, now_us: u64, link: LinkId, work: WifiWork) {
+    fn queue_wifi_write(&mut self, now_us: u64, link: LinkId, change: SettingsChange) {
         let Some(client) = self.router.client(link) else {
             return;
         };
-        let code = match &work {
-            WifiWork::Frame(frame) => frame.cmd(),
-            WifiWork::Text(_) => cmd::SET_SSID_PWD,
-        };
-        let write = WifiWrite {
-            client,
-            since_us: now_us,
-            work,
-        };
-        if self.wifi_writes.push_back(write).is_err() {
+        if let Err(change) = self.wifi_writes.push(now_us, client, change) {
             // A link has at most one change waiting unless its client does not wait for its
             // answers: refuse that one.
-            self.send_frame(link, &Reply::Byte(0).to_frame(code));
+            self.send_frame(link, &Reply::Byte(0).to_frame(change.cmd()));
         }
     }
 
     /// Writes the waiting Wi-Fi settings changes once no request is on the bus (or they have
-    /// waited [`WIFI_WRITE_WAIT_US`]), and answers each client that asked.
+    /// waited [`WIFI_WRITE_WAIT_US`](wifi::WIFI_WRITE_WAIT_US)), and answers each client that
+    /// asked.
     fn write_wifi_settings<I: BasicIo>(&mut self, now_us: u64, io: &mut I) {
-        while let Some(front) = self.wifi_writes.front() {
-            let waited = now_us.saturating_sub(front.since_us);
-            if !self.forwarder.idle() && waited < WIFI_WRITE_WAIT_US {
-                return;
-            }
-            let Some(write) = self.wifi_writes.pop_front() else {
-                return;
-            };
-            let answer = match write.work {
-                WifiWork::Frame(frame) => {
-                    let cx = local::Context {
-                        version_x10: self.config.version_x10,
-                        mode: self.status().mode,
-                        wifi: self.wifi.as_mut(),
-                        now_us,
-                    };
-                    local::answer(&frame, io, cx)
+        while let Some((client, change)) = self.wifi_writes.next_due(now_us, !self.forwarder.idle())
+        {
+            let answer = match change {
+                SettingsChange::Frame(frame) => {
+                    local::answer(&frame, io, self.local_context(now_us))
                 }
-                WifiWork::Text(end) => local::answer_set_text(end, io, self.wifi.as_mut(), now_us),
+                SettingsChange::Text(end) => {
+                    local::answer_set_text(end, io, self.wifi.as_mut(), now_us)
+                }
             };
             // The client may have gone meanwhile (its link closed or reused): then nobody is
             // answered, but the change stands.
             if let Some(answer) = answer
-                && self.router.client(write.client.link) == Some(write.client)
+                && self.router.client(client.link) == Some(client)
             {
-                self.send_answer(write.client.link, &answer);
+                self.send_answer(client.link, &answer);
             }
         }
     }

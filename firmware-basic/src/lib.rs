@@ -18,7 +18,7 @@
 //!   [`BasicIo::wifi_store`]) and the station machine; [`Basic::wifi_mut`] is how the board's
 //!   network layer drives the station. 0xB0's bare text is caught per link (a
 //!   [`wifi::SetTextCapture`] before that link's framer). A settings change is written to flash
-//!   when the bus is quiet (a flash erase stalls the CPU), at most [`WIFI_WRITE_WAIT_US`] after
+//!   when the bus is quiet (a flash erase stalls the CPU), at most [`wifi::WIFI_WRITE_WAIT_US`] after
 //!   it arrived. A board that lends no store has no Wi-Fi: 0xB0/0xB2 are refused with `00`,
 //!   0xB1 reports empty credentials in the text form pymycobot parses.
 //! * [`clients`]: the network clients (TCP) as the board's sockets and the virtual robot's
@@ -76,7 +76,7 @@ mod supervisor;
 pub mod transparent;
 pub mod wifi;
 
-pub use basic::{BUS_READ_BUDGET, Basic, WIFI_WRITE_WAIT_US};
+pub use basic::{BUS_READ_BUDGET, Basic};
 pub use clients::{NetClient, NetworkClients};
 pub use config::{BasicConfig, ConfigError, EchoMode};
 pub use host_link::LinkKind;

@@ -7,8 +7,9 @@
 mod common;
 
 use common::{Rig, WifiFlash, frame, wifi_flash};
+use firmware_basic::wifi::WIFI_WRITE_WAIT_US;
 use firmware_basic::wifi::{WifiConfig, WifiSettings};
-use firmware_basic::{BasicError, LinkId, WIFI_WRITE_WAIT_US};
+use firmware_basic::{BasicError, LinkId};
 
 const ACK: [u8; 6] = [0xFE, 0xFE, 0x03, 0xB0, 0x01, 0xFA];
 const NAK: [u8; 6] = [0xFE, 0xFE, 0x03, 0xB0, 0x00, 0xFA];

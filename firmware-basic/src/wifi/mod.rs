@@ -26,6 +26,7 @@ mod commands;
 pub mod config;
 pub mod connection;
 pub mod store;
+mod writes;
 
 pub use commands::{Wifi, WifiAnswer, WifiError, WifiReply, WifiStatus, writes_settings};
 pub use config::{
@@ -33,3 +34,4 @@ pub use config::{
 };
 pub use connection::{Action, Failure, JoinFailure, LinkEvent, Station, StationState};
 pub use store::{ChangeError, Changed, FlashWifiStore, LoadError, WifiConfig, WifiStore};
+pub use writes::{SettingsChange, SettingsWrites, WIFI_WRITE_WAIT_US};
