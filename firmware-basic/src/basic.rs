@@ -121,11 +121,6 @@ impl Basic {
         }
     }
 
-    /// True if `link` is open.
-    pub fn link_open(&self, link: LinkId) -> bool {
-        self.router.is_open(link)
-    }
-
     /// Does all pending work at time `now_us` (monotonic microseconds): reads what arrived on
     /// the host links and the bus, answers or forwards, checks deadlines. Never blocks; call it
     /// often (every few microseconds of bus time) and whenever bytes arrive. `hosts` are the
@@ -329,10 +324,10 @@ impl Basic {
     }
 
     /// Queues the answer to one of the Basic's own commands for `link`, noting what went wrong.
-    fn send_answer(&mut self, link: LinkId, answer: &local::Answer) {
-        let sent = match &answer.reply {
-            local::Reply::Frame(reply) => self.router.send_frame(link, reply),
-            local::Reply::Text(bytes) => self.router.send_bytes(link, bytes),
+    fn send_answer(&mut self, link: LinkId, answer: &local::LocalAnswer) {
+        let sent = match &answer.body {
+            local::AnswerBody::Frame(frame) => self.router.send_frame(link, frame),
+            local::AnswerBody::Text(bytes) => self.router.send_bytes(link, bytes),
         };
         if !sent {
             self.supervisor.error(BasicError::HostOverflow);

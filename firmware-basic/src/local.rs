@@ -21,7 +21,7 @@
 
 use heapless::Vec;
 use protocol_core::Frame;
-use protocol_core::command::{CommandError, Reply as ReplyData, Request, cmd, is_basic_local};
+use protocol_core::command::{CommandError, Reply, Request, cmd, is_basic_local};
 
 use crate::io::BasicIo;
 use crate::status::{BasicError, TransponderMode};
@@ -37,9 +37,9 @@ const NO_LEVEL: u8 = 0xFF;
 
 /// The Basic's answer to one of its own commands.
 #[derive(Debug, PartialEq, Eq)]
-pub(crate) struct Answer {
+pub(crate) struct LocalAnswer {
     /// The reply for the host.
-    pub(crate) reply: Reply,
+    pub(crate) body: AnswerBody,
     /// The transponder mode to switch to after the reply.
     pub(crate) new_mode: Option<TransponderMode>,
     /// What went wrong, for the display.
@@ -49,19 +49,19 @@ pub(crate) struct Answer {
     pub(crate) capture_text: bool,
 }
 
-/// A reply for the host.
+/// What goes back to the host: a frame, or bare text.
 #[derive(Debug, PartialEq, Eq)]
-pub(crate) enum Reply {
+pub(crate) enum AnswerBody {
     /// A reply frame.
     Frame(Frame),
     /// Bare text (0xB1).
     Text(Vec<u8, MAX_GET_TEXT>),
 }
 
-impl Answer {
-    fn reply(cmd: u8, data: ReplyData) -> Self {
+impl LocalAnswer {
+    fn frame(cmd: u8, data: Reply) -> Self {
         Self {
-            reply: Reply::Frame(data.to_frame(cmd)),
+            body: AnswerBody::Frame(data.to_frame(cmd)),
             new_mode: None,
             error: None,
             capture_text: false,
@@ -70,9 +70,9 @@ impl Answer {
 
     fn from_wifi(answer: WifiAnswer) -> Self {
         Self {
-            reply: match answer.reply {
-                WifiReply::Frame(frame) => Reply::Frame(frame),
-                WifiReply::Text(text) => Reply::Text(text),
+            body: match answer.reply {
+                WifiReply::Frame(frame) => AnswerBody::Frame(frame),
+                WifiReply::Text(text) => AnswerBody::Text(text),
             },
             new_mode: None,
             error: answer.error.map(BasicError::Wifi),
@@ -82,7 +82,7 @@ impl Answer {
 
     /// The status reply: `01` done, `00` refused.
     fn status(cmd: u8, done: bool) -> Self {
-        Self::reply(cmd, ReplyData::Byte(u8::from(done)))
+        Self::frame(cmd, Reply::Byte(u8::from(done)))
     }
 
     fn with_error(mut self, error: BasicError) -> Self {
@@ -104,7 +104,11 @@ pub(crate) struct Context<'a> {
 }
 
 /// Answers `frame` if it is one of the Basic's own commands; `None` if it is for the Atom.
-pub(crate) fn answer<I: BasicIo>(frame: &Frame, io: &mut I, cx: Context<'_>) -> Option<Answer> {
+pub(crate) fn answer<I: BasicIo>(
+    frame: &Frame,
+    io: &mut I,
+    cx: Context<'_>,
+) -> Option<LocalAnswer> {
     let code = frame.cmd();
     if !is_basic_local(code) {
         return None;
@@ -113,17 +117,17 @@ pub(crate) fn answer<I: BasicIo>(frame: &Frame, io: &mut I, cx: Context<'_>) -> 
         && let Some(store) = io.wifi_store()
         && let Some(answer) = wifi.answer(cx.now_us, frame, store)
     {
-        return Some(Answer::from_wifi(answer));
+        return Some(LocalAnswer::from_wifi(answer));
     }
     let (version_x10, mode) = (cx.version_x10, cx.mode);
     let answer = match Request::parse(frame) {
         Ok(Request::SetBasicOutput { pin, high }) => {
-            Answer::status(code, io.set_output(pin.gpio(), high))
+            LocalAnswer::status(code, io.set_output(pin.gpio(), high))
         }
         Ok(Request::GetBasicInput { pin }) => match io.read_input(pin.gpio()) {
-            Some(high) => Answer::reply(
+            Some(high) => LocalAnswer::frame(
                 code,
-                ReplyData::PinLevel {
+                Reply::PinLevel {
                     pin: pin.gpio(),
                     high,
                 },
@@ -134,8 +138,8 @@ pub(crate) fn answer<I: BasicIo>(frame: &Frame, io: &mut I, cx: Context<'_>) -> 
             let mut text = Vec::new();
             // Cannot fail: the text is shorter than any 0xB1 answer may be.
             let _ = text.extend_from_slice(NO_WIFI_TEXT);
-            Answer {
-                reply: Reply::Text(text),
+            LocalAnswer {
+                body: AnswerBody::Text(text),
                 new_mode: None,
                 error: None,
                 capture_text: false,
@@ -145,22 +149,22 @@ pub(crate) fn answer<I: BasicIo>(frame: &Frame, io: &mut I, cx: Context<'_>) -> 
             let mm = io
                 .tof_distance_mm()
                 .map_or(-1, |mm| i16::try_from(mm).unwrap_or(i16::MAX));
-            Answer::reply(code, ReplyData::Int16(mm))
+            LocalAnswer::frame(code, Reply::Int16(mm))
         }
-        Ok(Request::GetBasicVersion) => Answer::reply(code, ReplyData::Byte(version_x10)),
-        Ok(Request::SetTransponderMode { mode }) => Answer {
+        Ok(Request::GetBasicVersion) => LocalAnswer::frame(code, Reply::Byte(version_x10)),
+        Ok(Request::SetTransponderMode { mode }) => LocalAnswer {
             new_mode: Some(mode),
-            ..Answer::status(code, true)
+            ..LocalAnswer::status(code, true)
         },
-        Ok(Request::GetTransponderMode) => Answer::reply(code, ReplyData::Byte(mode as u8)),
+        Ok(Request::GetTransponderMode) => LocalAnswer::frame(code, Reply::Byte(mode as u8)),
         Err(CommandError::BadPin(pin)) if code == cmd::GET_BASIC_INPUT => {
             pin_unreadable(code, pin).with_error(BasicError::InvalidPin { pin })
         }
         Err(CommandError::BadPin(pin)) => {
-            Answer::status(code, false).with_error(BasicError::InvalidPin { pin })
+            LocalAnswer::status(code, false).with_error(BasicError::InvalidPin { pin })
         }
         // No Wi-Fi (0xB0, 0xB2), a bad level or mode, a wrong length: refused.
-        _ => Answer::status(code, false),
+        _ => LocalAnswer::status(code, false),
     };
     Some(answer)
 }
@@ -172,19 +176,19 @@ pub(crate) fn answer_set_text<I: BasicIo>(
     io: &mut I,
     wifi: Option<&mut Wifi>,
     now_us: u64,
-) -> Option<Answer> {
+) -> Option<LocalAnswer> {
     let store = io.wifi_store()?;
     wifi?
         .answer_set_text(now_us, end, store)
-        .map(Answer::from_wifi)
+        .map(LocalAnswer::from_wifi)
 }
 
 /// 0xA1's answer for a pin that cannot be read: the pin, level `FF`.
-fn pin_unreadable(code: u8, pin: u8) -> Answer {
+fn pin_unreadable(code: u8, pin: u8) -> LocalAnswer {
     let mut data = heapless::Vec::new();
     // Cannot fail: two bytes fit.
     let _ = data.extend_from_slice(&[pin, NO_LEVEL]);
-    Answer::reply(code, ReplyData::Raw(data))
+    LocalAnswer::frame(code, Reply::Raw(data))
 }
 
 #[cfg(test)]
@@ -216,7 +220,7 @@ mod tests {
         }
     }
 
-    fn ask(io: &mut FakeIo, cmd: u8, data: &[u8]) -> Option<Answer> {
+    fn ask(io: &mut FakeIo, cmd: u8, data: &[u8]) -> Option<LocalAnswer> {
         let cx = Context {
             version_x10: 12,
             mode: TransponderMode::Framed,
@@ -226,10 +230,10 @@ mod tests {
         answer(&Frame::new(cmd, data).unwrap(), io, cx)
     }
 
-    fn reply_bytes(answer: &Answer) -> std::vec::Vec<u8> {
-        match &answer.reply {
-            Reply::Frame(f) => f.to_bytes().to_vec(),
-            Reply::Text(bytes) => bytes.to_vec(),
+    fn reply_bytes(answer: &LocalAnswer) -> std::vec::Vec<u8> {
+        match &answer.body {
+            AnswerBody::Frame(f) => f.to_bytes().to_vec(),
+            AnswerBody::Text(bytes) => bytes.to_vec(),
         }
     }
 

@@ -159,7 +159,8 @@ impl Router {
         }
     }
 
-    /// True if `link` is open.
+    /// True if `link` is open (the tests' view; the Basic asks for [`Self::client`]).
+    #[cfg(test)]
     pub(crate) fn is_open(&self, link: LinkId) -> bool {
         self.slots.get(link.index()).is_some_and(|s| s.open)
     }
@@ -360,8 +361,9 @@ impl Router {
         self.host_link(link).is_some_and(|l| l.send_frame(frame))
     }
 
-    /// Queues one raw byte for `link`, dropping its oldest queued byte if its queue is full;
-    /// false if a byte was dropped.
+    /// Queues one raw byte for `link` (transparent mode), dropping its oldest queued byte if
+    /// its queue is full; false if a byte was dropped. A closed link takes nothing and loses
+    /// nothing: the byte goes nowhere and this is true.
     pub(crate) fn send_raw(&mut self, link: LinkId, byte: u8) -> bool {
         self.host_link(link).is_none_or(|l| l.send_raw(byte))
     }

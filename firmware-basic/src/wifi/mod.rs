@@ -12,9 +12,13 @@
 //!   effect, changed only after the flash write succeeded.
 //! * [`connection`]: the [`Station`] state machine: join, DHCP, reconnect with back-off, new
 //!   credentials, no credentials = off; actions out, driver events and time in.
-//! * [`Wifi`] (here): the three together, as the Basic will own them: answers 0xB0..0xB2,
-//!   keeps the station's credentials in step with the settings, and reports a [`WifiStatus`]
-//!   for the LCD.
+//! * `commands`: [`Wifi`], the three together as the Basic owns them (from its first poll on,
+//!   on a board that lends a store): answers 0xB0..0xB2, keeps the station's credentials in
+//!   step with the settings, and reports a [`WifiStatus`] for the LCD.
+//! * `writes`: [`SettingsWrites`], the changes (0xB0, 0xB2) waiting for a quiet bus before
+//!   they are written to flash, at most [`WIFI_WRITE_WAIT_US`].
+//!
+//! This file is the facade: the parts below it, and what the Basic and the board use of them.
 //!
 //! What a client sees: `01` when a setting was stored (or was already set), `00` when it was
 //! refused (an empty or over-long SSID, a password that is no WPA key, port 0, a text in
