@@ -5,11 +5,11 @@
 //! what a client sees.
 
 use protocol_core::command::{Reply, cmd, is_basic_local};
-use protocol_core::listener::{Listener, ListenerConfig};
+use protocol_core::listener::Listener;
 use protocol_core::{BytePort, Frame};
 
-use crate::config::{BasicConfig, EchoMode};
-use crate::forwarder::{Event, Forwarder};
+use crate::config::BasicConfig;
+use crate::forwarder::{self, Event, Forwarder};
 use crate::host_link::{HOST_READ_BUDGET, HostFrames, LinkKind};
 use crate::io::BasicIo;
 use crate::local;
@@ -23,18 +23,6 @@ use crate::wifi::{self, SettingsChange, SettingsWrites, Wifi, WifiStatus};
 /// Most bus bytes taken per poll: a poll stays short, and 256 bytes is 2.5 ms of bus time,
 /// far more than arrives between two polls of a board's loop.
 pub const BUS_READ_BUDGET: usize = 256;
-
-/// How the Basic hears the bus: host frames (the Atom's replies) and every byte that is not its
-/// own echo (transparent mode passes them on, and they show a reply that began garbled);
-/// servo packets are none of its business.
-pub(crate) fn bus_listener(echo: EchoMode) -> Listener {
-    Listener::new(
-        ListenerConfig::new()
-            .with_packets(false)
-            .with_bytes(true)
-            .with_echo(echo),
-    )
-}
 
 /// What the bus carries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -75,7 +63,7 @@ impl Basic {
             config,
             mode: Mode::Framed,
             router: Router::new(),
-            bus: bus_listener(config.echo),
+            bus: forwarder::bus_listener(config.echo),
             forwarder: Forwarder::new(),
             transparent: Transparent::default(),
             supervisor: Supervisor::new(&config),

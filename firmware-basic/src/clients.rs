@@ -283,7 +283,8 @@ impl<U: BytePort> HostPorts for ClientPorts<'_, U> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{BasicConfig, NullIo};
+    use crate::config::BasicConfig;
+    use crate::io::NullIo;
     use protocol_core::NullPort;
 
     fn poll(clients: &mut NetworkClients, basic: &mut Basic, now_us: u64) {

@@ -35,10 +35,10 @@
 
 use heapless::{Deque, Vec};
 use protocol_core::frame::{HEADER, MAX_FRAME_BYTES};
-use protocol_core::listener::{Echo, Heard, Listener};
+use protocol_core::listener::{Echo, Heard, Listener, ListenerConfig};
 use protocol_core::{BytePort, Frame, timing};
 
-use crate::config::BasicConfig;
+use crate::config::{BasicConfig, EchoMode};
 use crate::request::{Origin, Request};
 /// Bytes received further apart than this had silence between them (a new transmission
 /// began), in microseconds: one byte time and the reaction time.
@@ -73,6 +73,18 @@ pub fn may_start_after_quiet(quiet_us: u64) -> bool {
 /// client resends if it wants.
 pub(crate) fn may_resend(request: &Request) -> bool {
     !matches!(request.origin, Origin::Host(_))
+}
+
+/// How the Basic hears the bus: host frames (the Atom's replies) and every byte that is not its
+/// own echo (transparent mode passes them on, and they show a reply that began garbled);
+/// servo packets are none of its business.
+pub(crate) fn bus_listener(echo: EchoMode) -> Listener {
+    Listener::new(
+        ListenerConfig::new()
+            .with_packets(false)
+            .with_bytes(true)
+            .with_echo(echo),
+    )
 }
 
 /// How long after a request was given up on a frame with its CMD is still taken for its late

@@ -225,7 +225,7 @@ mod tests {
 
     /// The Basic's bus listener.
     fn listener() -> Listener {
-        crate::basic::bus_listener(crate::EchoMode::Auto)
+        crate::forwarder::bus_listener(crate::config::EchoMode::Auto)
     }
 
     /// Bytes from the bus, 10 us apart from 1 010 us (when the echo of a 3-byte write at

@@ -237,7 +237,8 @@ mod tests {
     use core::ops::Range;
     use flash_store::MemFlash;
 
-    use crate::wifi::{FlashWifiStore, SetTextCapture};
+    use crate::wifi::config::SetTextCapture;
+    use crate::wifi::store::FlashWifiStore;
 
     const RANGE: Range<u32> = 0..4 * 4096;
     type Store = FlashWifiStore<MemFlash<{ 4 * 4096 }>>;
