@@ -424,3 +424,190 @@ fn send_raw(router: &mut Router, link: LinkId, supervisor: &mut Supervisor, byte
         supervisor.error(BasicError::HostOverflow);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::collections::VecDeque;
+    use std::vec::Vec;
+
+    use super::*;
+    use crate::config::EchoMode;
+    use crate::io::NullIo;
+
+    /// The bus: what the Basic wrote, and bytes for it to read. No echo.
+    #[derive(Default)]
+    struct Bus {
+        rx: VecDeque<u8>,
+        sent: Vec<u8>,
+    }
+
+    impl BytePort for Bus {
+        fn read_byte(&mut self) -> Option<u8> {
+            self.rx.pop_front()
+        }
+
+        fn write(&mut self, bytes: &[u8]) {
+            self.sent.extend_from_slice(bytes);
+        }
+
+        fn tx_idle(&self) -> bool {
+            true
+        }
+    }
+
+    /// Every host link's bytes both ways.
+    #[derive(Default)]
+    struct Hosts {
+        rx: [VecDeque<u8>; MAX_HOST_LINKS],
+        tx: [Vec<u8>; MAX_HOST_LINKS],
+    }
+
+    impl HostPorts for Hosts {
+        fn read_from(&mut self, link: LinkId) -> Option<u8> {
+            self.rx[link.index()].pop_front()
+        }
+
+        fn write_to(&mut self, link: LinkId, bytes: &[u8]) {
+            self.tx[link.index()].extend_from_slice(bytes);
+        }
+
+        fn tx_idle_on(&self, _link: LinkId) -> bool {
+            true
+        }
+    }
+
+    /// Test bench: the Basic, its ports and the time.
+    struct Bench {
+        basic: Basic,
+        hosts: Hosts,
+        bus: Bus,
+        now_us: u64,
+    }
+
+    impl Bench {
+        /// A Basic that sends nothing of its own (no boot power-on, no probing), on a line
+        /// without echo.
+        fn new() -> Self {
+            let config = BasicConfig {
+                echo: EchoMode::Absent,
+                power_on_at_boot: false,
+                probe_interval_us: 0,
+                ..BasicConfig::default()
+            };
+            Self {
+                basic: Basic::new(config),
+                hosts: Hosts::default(),
+                bus: Bus::default(),
+                now_us: 0,
+            }
+        }
+
+        /// A booted Basic with a network client connected.
+        fn with_network_client() -> (Self, LinkId) {
+            let mut bench = Self::new();
+            bench.run_us(100);
+            let net = bench.basic.open_link(LinkKind::Network).unwrap();
+            (bench, net)
+        }
+
+        fn run_us(&mut self, us: u64) {
+            let end = self.now_us + us;
+            while self.now_us < end {
+                self.now_us += 10;
+                let (hosts, bus) = (&mut self.hosts, &mut self.bus);
+                self.basic.poll(self.now_us, hosts, bus, &mut NullIo);
+            }
+        }
+
+        fn host_sends(&mut self, link: LinkId, frame: &Frame) {
+            self.hosts.rx[link.index()].extend(frame.to_bytes().iter());
+        }
+
+        fn host_got(&mut self, link: LinkId) -> Vec<u8> {
+            core::mem::take(&mut self.hosts.tx[link.index()])
+        }
+    }
+
+    fn frame(code: u8, data: &[u8]) -> Frame {
+        Frame::new(code, data).unwrap()
+    }
+
+    fn bytes(frame: &Frame) -> Vec<u8> {
+        frame.to_bytes().to_vec()
+    }
+
+    #[test]
+    fn its_own_commands_are_answered_to_the_asker_and_never_reach_the_bus() {
+        let (mut bench, net) = Bench::with_network_client();
+        bench.host_sends(net, &frame(cmd::GET_BASIC_VERSION, &[]));
+        bench.run_us(5_000);
+        assert_eq!(
+            bench.host_got(net),
+            bytes(&frame(cmd::GET_BASIC_VERSION, &[10]))
+        );
+        assert!(bench.host_got(LinkId::USB).is_empty());
+        assert!(bench.bus.sent.is_empty());
+        assert_eq!(bench.basic.status().host_frames, 1);
+    }
+
+    #[test]
+    fn a_request_goes_onto_the_bus_and_its_reply_to_the_client_that_asked_only() {
+        let (mut bench, net) = Bench::with_network_client();
+        let request = frame(cmd::GET_ANGLES, &[]);
+        bench.host_sends(net, &request);
+        bench.run_us(5_000);
+        assert_eq!(bench.bus.sent, bytes(&request));
+        let reply = frame(cmd::GET_ANGLES, &[0; 12]);
+        bench.bus.rx.extend(bytes(&reply));
+        bench.run_us(5_000);
+        assert_eq!(bench.host_got(net), bytes(&reply));
+        assert!(bench.host_got(LinkId::USB).is_empty());
+        assert_eq!(bench.basic.status().replies_forwarded, 1);
+    }
+
+    #[test]
+    fn a_reply_for_a_client_that_left_reaches_nobody() {
+        let (mut bench, net) = Bench::with_network_client();
+        bench.host_sends(net, &frame(cmd::GET_ANGLES, &[]));
+        bench.run_us(5_000);
+        bench.basic.close_link(net);
+        assert_eq!(bench.basic.open_link(LinkKind::Network), Ok(net));
+        bench
+            .bus
+            .rx
+            .extend(bytes(&frame(cmd::GET_ANGLES, &[0; 12])));
+        bench.run_us(5_000);
+        assert!(bench.host_got(net).is_empty(), "not the newcomer's");
+        assert_eq!(bench.basic.status().replies_forwarded, 0);
+    }
+
+    #[test]
+    fn transparent_mode_belongs_to_the_link_that_switched_until_it_leaves() {
+        let (mut bench, net) = Bench::with_network_client();
+        bench.host_sends(net, &frame(cmd::SET_TRANSPONDER_MODE, &[1]));
+        bench.run_us(5_000);
+        assert_eq!(
+            bench.host_got(net),
+            bytes(&frame(cmd::SET_TRANSPONDER_MODE, &[1]))
+        );
+        assert_eq!(bench.basic.status().mode, TransponderMode::Transparent);
+        // Another client: 0xC2 refused, a request for the Atom dropped unanswered.
+        bench.host_sends(LinkId::USB, &frame(cmd::SET_TRANSPONDER_MODE, &[0]));
+        bench.host_sends(LinkId::USB, &frame(cmd::GET_ANGLES, &[]));
+        bench.run_us(5_000);
+        assert_eq!(
+            bench.host_got(LinkId::USB),
+            bytes(&frame(cmd::SET_TRANSPONDER_MODE, &[0]))
+        );
+        assert!(bench.bus.sent.is_empty());
+        assert_eq!(
+            bench.basic.status().last_error,
+            Some(BasicError::TransparentElsewhere {
+                cmd: cmd::GET_ANGLES
+            })
+        );
+        // The owner leaves: framed again.
+        bench.basic.close_link(net);
+        assert_eq!(bench.basic.status().mode, TransponderMode::Framed);
+    }
+}

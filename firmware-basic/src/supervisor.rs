@@ -256,3 +256,182 @@ impl Supervisor {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::request::{Client, LinkId};
+
+    const DELAY_US: u64 = 1_000_000;
+    const INTERVAL_US: u64 = 1_000_000;
+    const NO_BUTTON: Buttons = Buttons {
+        a: false,
+        b: false,
+        c: false,
+    };
+    /// The Basic's internal requests as [`next`] gives them.
+    const PROBE: Option<(u8, Origin)> = Some((cmd::IS_POWER_ON, Origin::Probe));
+    const POWER_ON: Option<(u8, Origin)> = Some((cmd::POWER_ON, Origin::PowerOn));
+    const BUTTON_A: Buttons = Buttons {
+        a: true,
+        ..NO_BUTTON
+    };
+
+    fn booted(config: BasicConfig) -> Supervisor {
+        let mut supervisor = Supervisor::new(&config);
+        supervisor.boot(0, &config);
+        supervisor
+    }
+
+    /// The internal request at `now_us` on an idle bus: its command and origin.
+    fn next(supervisor: &mut Supervisor, now_us: u64, buttons: Buttons) -> Option<(u8, Origin)> {
+        supervisor
+            .next_internal(now_us, &BasicConfig::default(), buttons, true)
+            .map(|r| (r.frame.cmd(), r.origin))
+    }
+
+    fn request(code: u8, origin: Origin) -> Request {
+        Request {
+            frame: Frame::new(code, &[]).unwrap(),
+            origin,
+            queued_us: 0,
+        }
+    }
+
+    fn answered(code: u8, origin: Origin, data: &[u8]) -> Event {
+        Event::Reply {
+            request: request(code, origin),
+            reply: Frame::new(code, data).unwrap(),
+        }
+    }
+
+    fn host() -> Origin {
+        Origin::Host(Client::new(LinkId::USB, 0))
+    }
+
+    #[test]
+    fn at_boot_it_asks_first_and_powers_on_only_an_atom_that_says_it_is_off() {
+        let mut supervisor = booted(BasicConfig::default());
+        assert_eq!(next(&mut supervisor, DELAY_US - 1, NO_BUTTON), None);
+        assert_eq!(next(&mut supervisor, DELAY_US, NO_BUTTON), PROBE);
+        supervisor.on_event(
+            DELAY_US + 1_000,
+            &answered(cmd::IS_POWER_ON, Origin::Probe, &[0]),
+        );
+        assert_eq!(supervisor.status.atom_powered, Some(false));
+        assert_eq!(next(&mut supervisor, DELAY_US + 1_000, NO_BUTTON), POWER_ON);
+        supervisor.on_event(
+            DELAY_US + 2_000,
+            &answered(cmd::POWER_ON, Origin::PowerOn, &[1]),
+        );
+        assert_eq!(supervisor.status.atom_powered, Some(true));
+        assert_eq!(supervisor.status.atom, AtomLink::Answering);
+        // Powered: from now on only the liveness probe, after a silence of the interval.
+        assert_eq!(next(&mut supervisor, DELAY_US + 3_000, NO_BUTTON), None);
+        assert_eq!(
+            next(&mut supervisor, DELAY_US + 2_000 + INTERVAL_US, NO_BUTTON),
+            PROBE
+        );
+    }
+
+    #[test]
+    fn an_atom_that_says_it_is_on_is_left_alone() {
+        let mut supervisor = booted(BasicConfig::default());
+        assert!(next(&mut supervisor, DELAY_US, NO_BUTTON).is_some());
+        supervisor.on_event(
+            DELAY_US + 500_000,
+            &answered(cmd::IS_POWER_ON, Origin::Probe, &[1]),
+        );
+        // Not even asked again until the Atom has been silent for the interval.
+        assert_eq!(
+            next(&mut supervisor, DELAY_US + INTERVAL_US, NO_BUTTON),
+            None
+        );
+        assert_eq!(
+            next(&mut supervisor, DELAY_US + 500_000 + INTERVAL_US, NO_BUTTON),
+            PROBE
+        );
+    }
+
+    #[test]
+    fn a_host_request_after_the_off_answer_makes_it_ask_again_before_powering_on() {
+        let mut supervisor = booted(BasicConfig::default());
+        assert!(next(&mut supervisor, DELAY_US, NO_BUTTON).is_some());
+        supervisor.on_event(DELAY_US, &answered(cmd::IS_POWER_ON, Origin::Probe, &[0]));
+        // A client's move reached the Atom meanwhile: it may be running now.
+        supervisor.on_event(DELAY_US + 500, &answered(0x22, host(), &[1]));
+        assert_eq!(next(&mut supervisor, DELAY_US + 1_000, NO_BUTTON), PROBE);
+    }
+
+    #[test]
+    fn a_host_power_command_takes_the_power_out_of_the_basics_hands() {
+        let mut supervisor = booted(BasicConfig::default());
+        supervisor.on_host_request(cmd::POWER_OFF);
+        assert_eq!(supervisor.status.host_frames, 1);
+        // Only the liveness probe, never a power-on.
+        assert_eq!(next(&mut supervisor, DELAY_US, NO_BUTTON), PROBE);
+        supervisor.on_event(DELAY_US, &answered(cmd::IS_POWER_ON, Origin::Probe, &[0]));
+        assert_eq!(
+            next(&mut supervisor, DELAY_US + INTERVAL_US, NO_BUTTON),
+            PROBE,
+            "an Atom that is off is probed, not powered on"
+        );
+    }
+
+    #[test]
+    fn button_a_powers_on_once_per_press_and_a_button_held_from_boot_waits_for_a_release() {
+        let config = BasicConfig {
+            power_on_at_boot: false,
+            ..BasicConfig::default()
+        };
+        let mut supervisor = booted(config);
+        // Held from boot: nothing.
+        assert_eq!(next(&mut supervisor, 10, BUTTON_A), None);
+        assert_eq!(next(&mut supervisor, 20, NO_BUTTON), None);
+        assert_eq!(next(&mut supervisor, 30, BUTTON_A), POWER_ON);
+        // Unanswered and still held: once; afterwards only the probe.
+        supervisor.on_event(
+            60_000,
+            &Event::Timeout(request(cmd::POWER_ON, Origin::PowerOn)),
+        );
+        assert_eq!(next(&mut supervisor, 30 + INTERVAL_US, BUTTON_A), PROBE);
+        // Released and pressed again: at once.
+        assert_eq!(next(&mut supervisor, 40 + INTERVAL_US, NO_BUTTON), None);
+        assert_eq!(next(&mut supervisor, 50 + INTERVAL_US, BUTTON_A), POWER_ON);
+    }
+
+    #[test]
+    fn it_only_counts_what_becomes_of_requests_and_replies() {
+        let mut supervisor = booted(BasicConfig {
+            power_on_at_boot: false,
+            ..BasicConfig::default()
+        });
+        supervisor.on_event(1, &Event::Timeout(request(0x20, host())));
+        assert_eq!(supervisor.status.atom, AtomLink::Silent);
+        assert_eq!(supervisor.status.timeouts, 1);
+        assert_eq!(
+            supervisor.status.last_error,
+            Some(BasicError::ReplyTimeout { cmd: 0x20 })
+        );
+        let late = Event::Late {
+            request: request(0x20, host()),
+            reply: Frame::new(0x20, &[1]).unwrap(),
+        };
+        supervisor.on_event(2, &late);
+        assert_eq!(supervisor.status.late_replies, 1);
+        assert_eq!(supervisor.status.atom, AtomLink::Answering);
+        supervisor.on_event(3, &Event::Collision);
+        supervisor.on_event(4, &Event::GaveUp(request(0x21, host())));
+        assert_eq!(supervisor.status.collisions, 2);
+        supervisor.on_event(5, &Event::Expired(request(0x22, host())));
+        assert_eq!(
+            supervisor.status.last_error,
+            Some(BasicError::QueueFull { cmd: 0x22 })
+        );
+        supervisor.on_delivery(Delivery::Queued);
+        supervisor.on_delivery(Delivery::Gone);
+        assert_eq!(supervisor.status.replies_forwarded, 1);
+        supervisor.on_delivery(Delivery::NoRoom);
+        assert_eq!(supervisor.status.last_error, Some(BasicError::HostOverflow));
+    }
+}
