@@ -13,7 +13,7 @@
 //! request again: an echo that is missing or cut short, another station's bytes heard while
 //! transmitting on a line not known to echo, a reply that comes garbled or late - the request
 //! may have reached the Atom, and a client's request reaches the Atom at most once
-//! ([`may_resend`]). The client resends if it wants (pymycobot after 0.5 s).
+//! (`may_resend`). The client resends if it wants (pymycobot after 0.5 s).
 //!
 //! Then only a complete `FE FE` frame with the request's CMD counts as the reply; servo
 //! packets, other frames and late replies are dropped, and a request that gets no reply is
@@ -25,7 +25,7 @@
 //! Atom; under emulation, any Atom). The Atom answers one request at a time, in order, so the
 //! forwarder keeps the last few requests it gave up on ([`MAX_LATE`], for
 //! [`LATE_REPLY_WINDOW_US`]) and takes a frame with one of their CMDs for the oldest such
-//! request's reply: that reply goes to nobody but the status ([`Event::Late`]), and is never
+//! request's reply: that reply goes to nobody but the status (`Event::Late`), and is never
 //! taken for the reply to the request now in flight, nor for a garbled one. Only when the
 //! request in flight asks the same as the late one, for the same client (its resend), does the
 //! late reply answer it.

@@ -1,6 +1,6 @@
 //! Who asked for a request to the Atom, and so where its reply goes: the host links' ids
-//! ([`LinkId`]), one client on one link ([`Client`]), a request with its origin ([`Request`],
-//! [`Origin`]) and what became of a reply for a client ([`Delivery`]).
+//! ([`LinkId`]), one client on one link (`Client`), a request with its origin (`Request`,
+//! `Origin`) and what became of a reply for a client (`Delivery`).
 //!
 //! These are the words the router (which hands out requests and delivers replies) and the
 //! forwarder (which carries one request at a time over the bus) share; neither depends on the

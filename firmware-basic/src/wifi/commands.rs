@@ -81,7 +81,7 @@ impl WifiStatus {
 }
 
 /// The Basic's Wi-Fi: its settings and its station. The flash store is lent to the calls that
-/// need it. See the [module doc](self).
+/// need it. See the [module doc](super).
 #[derive(Clone, Debug)]
 pub struct Wifi {
     config: WifiConfig,

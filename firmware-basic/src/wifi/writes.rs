@@ -47,7 +47,8 @@ struct Waiting<K> {
 }
 
 /// Settings changes waiting for a quiet bus, oldest first, each with who asked (`K`); at most
-/// `N`. See the [module doc](self).
+/// `N`. A change is due once no request is on the bus, or once it has waited
+/// [`WIFI_WRITE_WAIT_US`] (a flash erase stalls the CPU).
 #[derive(Debug)]
 pub struct SettingsWrites<K, const N: usize> {
     waiting: Deque<Waiting<K>, N>,
