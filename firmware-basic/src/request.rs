@@ -87,3 +87,26 @@ pub(crate) struct Request {
     /// When it arrived (or was made), in microseconds.
     pub(crate) queued_us: u64,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ids_are_indexes_into_the_table() {
+        assert_eq!(LinkId::from_index(3).map(LinkId::index), Some(3));
+        assert_eq!(LinkId::from_index(MAX_HOST_LINKS), None);
+    }
+
+    #[test]
+    fn a_client_is_its_link_and_its_session() {
+        let first = Client::new(LinkId::USB, 0);
+        assert_eq!(first.link, LinkId::USB);
+        assert_eq!(first.session(), 0);
+        assert_ne!(
+            first,
+            Client::new(LinkId::USB, 1),
+            "a later client on the same link"
+        );
+    }
+}

@@ -509,10 +509,4 @@ mod tests {
             "the Basic's own requests are not held up"
         );
     }
-
-    #[test]
-    fn ids_are_indexes_into_the_table() {
-        assert_eq!(LinkId::from_index(3).map(LinkId::index), Some(3));
-        assert_eq!(LinkId::from_index(MAX_HOST_LINKS), None);
-    }
 }
