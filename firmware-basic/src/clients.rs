@@ -113,15 +113,6 @@ impl NetworkClients {
         }
     }
 
-    /// Every client has gone (the network went down): their links on `basic` are closed.
-    pub fn disconnect_all(&mut self, basic: &mut Basic) {
-        for slot in &mut self.slots {
-            if let Some(gone) = slot.take() {
-                basic.close_link(gone.link);
-            }
-        }
-    }
-
     /// Forgets every client without closing links: the Basic they were on has restarted (and
     /// has no links but USB). Handles given out before still reach nobody.
     pub fn clear(&mut self) {
@@ -372,7 +363,7 @@ mod tests {
         let new = clients.connect(&mut basic).unwrap();
         assert_ne!(old, new);
         assert!(!clients.is_connected(old));
-        clients.disconnect_all(&mut basic);
+        clients.disconnect(&mut basic, new);
         assert_eq!(clients.count(), 0);
         assert_eq!(basic.open_link(LinkKind::Network).map(LinkId::index), Ok(1));
     }
