@@ -1,5 +1,6 @@
 //! What the Atom knows about each servo, refreshed from the bus.
 
+use protocol_core::command::ServoErrorCode;
 use protocol_core::units::Steps;
 
 /// The latest state read from one servo (registers 40..=70: torque, goal, present state;
@@ -39,4 +40,20 @@ pub struct ServoHealth {
     pub corrupt_answers: bool,
     /// Consecutive missed state reads.
     pub(crate) misses: u8,
+}
+
+impl ServoHealth {
+    /// This servo's entry of read next error (0x15): corrupt answers, no answer, a fault, or
+    /// none.
+    pub fn error_code(&self) -> ServoErrorCode {
+        if !self.answering && self.corrupt_answers {
+            ServoErrorCode::BadAnswer
+        } else if !self.answering {
+            ServoErrorCode::NoAnswer
+        } else if self.fault_bits & ServoErrorCode::FAULT_MASK != 0 {
+            ServoErrorCode::Fault(self.fault_bits)
+        } else {
+            ServoErrorCode::Ok
+        }
+    }
 }

@@ -3,10 +3,9 @@
 
 use protocol_core::units::{Centideg, Steps};
 
-use crate::bank::ServoBank;
-use crate::config::{JOINTS, SERVOS, STEPS_PER_TURN};
-use crate::safety::{Goal, GoalSet};
-use crate::settings::Settings;
+use crate::config::{JOINTS, STEPS_PER_TURN};
+use crate::context::Context;
+use crate::safety::{Goal, Goals};
 
 /// Time from computing a goal to the servo acting on it, in microseconds: a transaction may be
 /// on the wire (up to about 0.6 ms), then the gap and the SYNC WRITE itself (about 0.7 ms).
@@ -41,17 +40,19 @@ impl Braking {
     /// ([`GOAL_LATENCY_US`]) and while braking (`v_j * T / 2`). A stop is kept within the
     /// joint's limits, but a joint already past a limit (the user just tightened it) stays
     /// where it is rather than being dragged back.
-    pub fn of(bank: &ServoBank, settings: &Settings) -> Self {
+    pub fn of(cx: &Context<'_>) -> Self {
+        let (bank, settings, now_us) = (&*cx.bank, cx.settings, cx.now_us);
         let config = settings.config();
         let a = i64::from(config.motion.servo_accel_steps_per_s2.max(1));
         let v_max = (0..JOINTS)
-            .map(|j| i64::from(bank.last_known_velocity(j)).abs())
+            .map(|j| i64::from(bank.last_known_velocity(now_us, j)).abs())
             .max()
             .unwrap_or(0);
         let brake_us = v_max * 1_000_000 / a;
         let mut goals = [None; JOINTS];
-        let present: [Centideg; JOINTS] =
-            core::array::from_fn(|j| config.millisteps_to_angle(j, bank.last_known_millisteps(j)));
+        let present: [Centideg; JOINTS] = core::array::from_fn(|j| {
+            config.millisteps_to_angle(j, bank.last_known_millisteps(now_us, j))
+        });
         let mut rest = present;
         for j in 0..JOINTS {
             // Every joint that holds torque, including one whose latest reads were lost: it
@@ -59,8 +60,8 @@ impl Braking {
             if !bank.holds_torque(j) {
                 continue;
             }
-            let v = i64::from(bank.last_known_velocity(j));
-            let stop = rest_steps(bank, j, brake_us);
+            let v = i64::from(bank.last_known_velocity(now_us, j));
+            let stop = rest_steps(cx, j, brake_us);
             let now = present.get(j).copied().unwrap_or_default();
             let mut angle = settings.angle(j, stop);
             if let Some(limit) = settings.limit(j) {
@@ -95,12 +96,10 @@ impl Braking {
     /// Sends the stop, one joint at a time: a joint whose stop the safety check refuses (it
     /// stands outside its limits after being moved by hand) keeps its previous goal, and the
     /// others still stop.
-    pub fn send(&self, bank: &mut ServoBank, settings: &Settings) {
+    pub fn send(&self, cx: &mut Context<'_>) {
         for (j, goal) in self.goals.iter().enumerate() {
-            let mut one: GoalSet = [None; SERVOS];
-            if let (Some(slot), Some(g)) = (one.get_mut(j), goal) {
-                *slot = Some(*g);
-                let _ = bank.send_goals(settings, one);
+            if let Some(g) = goal {
+                let _ = cx.send_goals(Goals::one(j, *g));
             }
         }
     }
@@ -109,25 +108,26 @@ impl Braking {
 /// Where servo `index` comes to rest when it brakes for `brake_us`, decelerating evenly from
 /// its last read speed: its estimated present position, plus what it covers until the goal
 /// arrives ([`GOAL_LATENCY_US`]) and while braking (`v * brake / 2`).
-fn rest_steps(bank: &ServoBank, index: usize, brake_us: i64) -> Steps {
-    let v = i64::from(bank.last_known_velocity(index));
+fn rest_steps(cx: &Context<'_>, index: usize, brake_us: i64) -> Steps {
+    let v = i64::from(cx.bank.last_known_velocity(cx.now_us, index));
     let travel_millisteps = v * (GOAL_LATENCY_US as i64 + brake_us / 2) / 1000;
-    let stop = (bank.last_known_millisteps(index) + travel_millisteps + 500).div_euclid(1000);
+    let at = cx.bank.last_known_millisteps(cx.now_us, index);
+    let stop = (at + travel_millisteps + 500).div_euclid(1000);
     Steps(stop.clamp(0, i64::from(STEPS_PER_TURN) - 1) as i16)
 }
 
 /// The goal that stops servo `index` (the gripper, or one joint on its own) at the servos' full
 /// deceleration, where it comes to rest; `None` if it holds no torque.
-pub fn stop_one(bank: &ServoBank, settings: &Settings, index: usize) -> Option<Goal> {
-    if !bank.holds_torque(index) {
+pub fn stop_one(cx: &Context<'_>, index: usize) -> Option<Goal> {
+    if !cx.bank.holds_torque(index) {
         return None;
     }
-    let config = settings.config();
+    let config = cx.settings.config();
     let a = i64::from(config.motion.servo_accel_steps_per_s2.max(1));
-    let v = i64::from(bank.last_known_velocity(index));
+    let v = i64::from(cx.bank.last_known_velocity(cx.now_us, index));
     let brake_us = v.abs() * 1_000_000 / a;
     Some(Goal {
-        position: rest_steps(bank, index, brake_us),
+        position: rest_steps(cx, index, brake_us),
         speed_steps_per_s: v
             .unsigned_abs()
             .clamp(SETTLE_SPEED_STEPS_PER_S, u64::from(u16::MAX)) as u16,

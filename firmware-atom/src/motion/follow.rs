@@ -10,9 +10,9 @@
 
 use protocol_core::units::{Centideg, Steps};
 
-use crate::bank::ServoBank;
-use crate::config::{JOINTS, SERVOS, STEPS_PER_TURN};
-use crate::safety::{Goal, GoalSet};
+use crate::config::{JOINTS, STEPS_PER_TURN};
+use crate::context::Context;
+use crate::safety::{Goal, Goals};
 use crate::settings::Settings;
 
 /// How much of the difference between where a joint was expected to be and where its state
@@ -39,6 +39,21 @@ pub enum Pace {
     Together,
 }
 
+/// One target of a sequence and how to get there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Leg {
+    /// The joint angles to pass.
+    pub target: [Centideg; JOINTS],
+    /// Time until the next target is due, microseconds.
+    pub period_us: u64,
+    /// No joint faster than this, steps per second.
+    pub speed_cap_steps_per_s: u32,
+    /// How the joints change speed.
+    pub pace: Pace,
+    /// The sequence ends here: stop at `target`.
+    pub last: bool,
+}
+
 /// Follows a sequence of targets. See the [module doc](self).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Follower {
@@ -48,20 +63,17 @@ pub struct Follower {
 }
 
 impl Follower {
-    /// The goals that carry the joints to `target` in `period_us` and on (see the
-    /// [module doc](self)), no joint faster than `speed_cap_steps_per_s`. `last`: the sequence
-    /// ends here, stop at `target`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn goals_towards(
-        &mut self,
-        bank: &ServoBank,
-        settings: &Settings,
-        target: &[Centideg; JOINTS],
-        period_us: u64,
-        speed_cap_steps_per_s: u32,
-        pace: Pace,
-        last: bool,
-    ) -> GoalSet {
+    /// The goals that carry the joints to `leg`'s target in its period and on (see the
+    /// [module doc](self)), from where the joints are at the step's time.
+    pub fn goals_towards(&mut self, cx: &Context<'_>, leg: &Leg) -> Goals {
+        let (bank, settings) = (&*cx.bank, cx.settings);
+        let Leg {
+            target,
+            period_us,
+            speed_cap_steps_per_s,
+            pace,
+            last,
+        } = *leg;
         let config = settings.config();
         let full = i64::from(config.motion.servo_accel_steps_per_s2.max(100));
         let period = period_us.max(1) as i64;
@@ -79,7 +91,7 @@ impl Follower {
             }
         });
         let from: [i64; JOINTS] = core::array::from_fn(|j| {
-            let measured = bank.estimated_millisteps(j);
+            let measured = bank.estimated_millisteps(cx.now_us, j);
             match &self.last {
                 Some((expected, _)) if !last => {
                     let e = expected.get(j).copied().unwrap_or(measured);
@@ -117,9 +129,9 @@ impl Follower {
             .max()
             .unwrap_or(0);
         let together_us = (largest * 1_000_000 / full).max(1_000);
-        let mut goals: GoalSet = [None; SERVOS];
+        let mut goals = Goals::NONE;
         let mut expected = to;
-        for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
+        for j in 0..JOINTS {
             if !answering.get(j).copied().unwrap_or(false) {
                 continue;
             }
@@ -149,11 +161,12 @@ impl Follower {
                 *e = f + speed.signum() * i64::from(speed_register) * period / 1000;
             }
             let t = to.get(j).copied().unwrap_or(f);
-            *slot = Some(Goal {
+            let goal = Goal {
                 position: goal_position(settings, j, t + beyond),
                 speed_steps_per_s: speed_register,
                 accel: accel_register,
-            });
+            };
+            goals.set(j, Some(goal));
         }
         self.last = Some((expected, speeds));
         goals
