@@ -191,3 +191,104 @@ fn restore(
     ops.into_iter()
         .all(|op| op.is_some_and(|op| cx.bank.queue_op(op)))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::{at_rest, queued};
+
+    /// Blocks kept in memory.
+    #[derive(Default)]
+    struct Memory(std::vec::Vec<(u8, Block)>);
+
+    impl ParamStore for Memory {
+        fn load(&mut self, id: u8) -> Result<Option<Block>, StoreError> {
+            Ok(self.0.iter().find(|(i, _)| *i == id).map(|(_, b)| *b))
+        }
+        fn save(&mut self, id: u8, block: &Block) -> Result<(), StoreError> {
+            self.0.retain(|(i, _)| *i != id);
+            self.0.push((id, *block));
+            Ok(())
+        }
+    }
+
+    /// A block in position mode, every other byte `fill`, the homing offset `homing_offset`.
+    fn block(fill: u8, homing_offset: u8) -> Block {
+        let mut b = [fill; BLOCK_LEN];
+        b[MODE_AT] = 0;
+        b[HOMING_OFFSET_AT] = homing_offset;
+        b[HOMING_OFFSET_AT + 1] = 0;
+        b
+    }
+
+    /// Takes `present` as joint 2's block (bus id 2) for a backup or a restore, with `saved`
+    /// in the store: whether that worked, what it queued, whether the joint still holds torque,
+    /// and the store.
+    fn take_joint_2(
+        restoring: bool,
+        saved: Option<Block>,
+        present: Option<Block>,
+    ) -> (bool, std::vec::Vec<Op>, bool, Memory) {
+        let (settings, mut bank) = at_rest();
+        let mut store = Memory::default();
+        if let Some(saved) = saved {
+            store.save(2, &saved).unwrap();
+        }
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        let mut motion = MotionController::new();
+        let ok = take_block(cx, &mut motion, Some(&mut store), restoring, 1, present);
+        let ops = queued(&mut bank, &settings);
+        (ok, ops, bank.enabled(1), store)
+    }
+
+    #[test]
+    fn a_backup_stores_the_block_under_the_servo_id() {
+        let (ok, ops, _, mut store) = take_joint_2(false, None, Some(block(7, 0)));
+        assert!(ok && ops.is_empty());
+        assert_eq!(store.load(2), Ok(Some(block(7, 0))));
+        assert!(!take_joint_2(false, None, None).0, "no answer");
+    }
+
+    #[test]
+    fn a_restore_writes_the_saved_block_back_with_the_eeprom_open() {
+        let (ok, ops, holds, _) = take_joint_2(true, Some(block(9, 0)), Some(block(4, 0)));
+        assert!(ok);
+        assert_eq!(
+            ops,
+            [
+                Op::write(2, reg::EEPROM_LOCK, &[0]).unwrap(),
+                Op::write(2, BLOCK_ADDR, &block(9, 0)).unwrap(),
+                Op::write(2, reg::EEPROM_LOCK, &[1]).unwrap(),
+            ]
+        );
+        assert!(holds, "the zero stayed: the servo holds on");
+    }
+
+    #[test]
+    fn a_restore_that_moves_the_zero_releases_the_servo_first() {
+        let (ok, ops, holds, _) = take_joint_2(true, Some(block(9, 30)), Some(block(9, 0)));
+        assert!(ok);
+        assert_eq!(ops[0], Op::write(2, reg::TORQUE_ENABLE, &[0]).unwrap());
+        assert_eq!(ops.len(), 4);
+        assert!(!holds);
+    }
+
+    #[test]
+    fn a_restore_needs_a_backup_in_position_mode() {
+        let (ok, ops, _, _) = take_joint_2(true, None, Some(block(9, 0)));
+        assert!(!ok && ops.is_empty(), "no backup");
+        let mut wheel = block(9, 0);
+        wheel[MODE_AT] = 1;
+        let (ok, ops, _, _) = take_joint_2(true, Some(wheel), Some(block(9, 0)));
+        assert!(!ok && ops.is_empty(), "not in position mode");
+    }
+
+    #[test]
+    fn the_reads_cover_the_servos_asked_for_with_room_for_the_writes() {
+        let (settings, mut bank) = at_rest();
+        let cx = Context::new(0, &mut bank, &settings);
+        let (ops, servos) = reads(&cx, ServoSelect::All, true).unwrap();
+        assert_eq!((ops.len(), servos), (JOINTS, 0b11_1111));
+        assert_eq!(reads(&cx, ServoSelect::All, false), Err(AtomError::Invalid));
+    }
+}

@@ -583,3 +583,278 @@ impl ServoBank {
         self.health(GRIPPER).map(|h| h.position).unwrap_or_default()
     }
 }
+
+/// Servo state reads and banks that have read them, for the unit tests of the parts that act
+/// on the servos.
+#[cfg(test)]
+pub(crate) mod test_support {
+    use protocol_core::servo::{Packet, reg, to_sign_magnitude};
+
+    use super::{STATE_READ_ADDR, STATE_READ_LEN, ServoBank};
+    use crate::config::{AtomConfig, JOINTS, SERVOS};
+    use crate::driver::{Op, Outcome};
+    use crate::settings::Settings;
+
+    /// The settings of a powered arm with the default configuration.
+    pub fn powered() -> Settings {
+        Settings::new(AtomConfig {
+            powered_at_boot: true,
+            ..AtomConfig::default()
+        })
+    }
+
+    /// The state read (registers 40..=70) of servo `id` holding torque at `position`, moving at
+    /// `speed` steps/s, its goal register at `goal`.
+    pub fn state(id: u8, position: i16, speed: i16, goal: i16) -> Packet {
+        let mut regs = [0u8; STATE_READ_LEN as usize];
+        let mut put = |addr: u8, bytes: &[u8]| {
+            let at = usize::from(addr - STATE_READ_ADDR);
+            regs[at..at + bytes.len()].copy_from_slice(bytes);
+        };
+        put(reg::TORQUE_ENABLE, &[1]);
+        put(reg::ACCELERATION, &[50]);
+        put(
+            reg::GOAL_POSITION,
+            &to_sign_magnitude(goal, 15).to_le_bytes(),
+        );
+        put(reg::GOAL_SPEED, &1000u16.to_le_bytes());
+        put(
+            reg::PRESENT_POSITION,
+            &to_sign_magnitude(position, 15).to_le_bytes(),
+        );
+        put(
+            reg::PRESENT_SPEED,
+            &to_sign_magnitude(speed, 15).to_le_bytes(),
+        );
+        put(reg::MOVING, &[u8::from(speed != 0)]);
+        Packet::new(id, 0, &regs).expect("a state read fits a packet")
+    }
+
+    /// Reads servo `index` at `now_us` as [`state`] says.
+    pub fn read(
+        bank: &mut ServoBank,
+        settings: &Settings,
+        now_us: u64,
+        index: usize,
+        state: Packet,
+    ) {
+        let id = settings.config().servo_ids[index];
+        let op = Op::Read {
+            id,
+            addr: STATE_READ_ADDR,
+            count: STATE_READ_LEN,
+        };
+        assert_eq!(
+            bank.finish(now_us, settings, op, Outcome::Answered(state), false),
+            None
+        );
+    }
+
+    /// A bank that read every servo at `now_us`: joint `j` at `positions[j]` moving at
+    /// `speeds[j]` steps/s toward a goal far ahead (at rest: its goal is where it is), the
+    /// gripper at 2048.
+    pub fn bank_read(
+        settings: &Settings,
+        now_us: u64,
+        positions: [i16; JOINTS],
+        speeds: [i16; JOINTS],
+    ) -> ServoBank {
+        let mut bank = ServoBank::new(settings);
+        for i in 0..SERVOS {
+            let (position, speed) = if i < JOINTS {
+                (positions[i], speeds[i])
+            } else {
+                (2048, 0)
+            };
+            let goal = position.saturating_add(speed.signum() * 1000);
+            let id = settings.config().servo_ids[i];
+            read(
+                &mut bank,
+                settings,
+                now_us,
+                i,
+                state(id, position, speed, goal),
+            );
+        }
+        bank
+    }
+
+    /// A powered arm ([`powered`]) whose bank read every servo at rest at 2048 (every joint
+    /// at 0 deg) at time 0.
+    pub fn at_rest() -> (Settings, ServoBank) {
+        let settings = powered();
+        let bank = bank_read(&settings, 0, [2048; JOINTS], [0; JOINTS]);
+        (settings, bank)
+    }
+
+    /// Every operation queued in `bank`, in order, each finished as sent.
+    pub fn queued(bank: &mut ServoBank, settings: &Settings) -> std::vec::Vec<Op> {
+        let mut ops = std::vec::Vec::new();
+        while let Some(op) = bank.due_job() {
+            ops.push(op.clone());
+            bank.finish(0, settings, op, Outcome::Sent, false);
+        }
+        ops
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use protocol_core::servo::Packet;
+
+    use super::test_support::{at_rest, bank_read, powered, read, state};
+    use super::*;
+    use crate::driver::Op;
+
+    fn goal(position: i16) -> Goal {
+        Goal {
+            position: Steps(position),
+            speed_steps_per_s: 500,
+            accel: 20,
+        }
+    }
+
+    #[test]
+    fn goals_sent_before_the_write_merge_into_one_sync_write() {
+        let (settings, mut bank) = at_rest();
+        bank.send_goals(10, &settings, Goals::one(0, goal(2100)))
+            .unwrap();
+        bank.send_goals(20, &settings, Goals::one(1, goal(2200)))
+            .unwrap();
+        bank.send_goals(30, &settings, Goals::one(0, goal(2150)))
+            .unwrap();
+        let Some(Op::Broadcast(write)) = bank.take_goal_write(&settings) else {
+            panic!("one SYNC WRITE");
+        };
+        // Two servos' move blocks (id + 7 bytes each) after the address and length.
+        assert_eq!(write.params().len(), 2 + 2 * 8);
+        assert_eq!(bank.take_goal_write(&settings), None, "taken");
+        assert_eq!(
+            bank.last_goal(0),
+            Some(goal(2150)),
+            "the newer goal of joint 1"
+        );
+        assert_eq!(bank.last_goal(1), Some(goal(2200)));
+    }
+
+    #[test]
+    fn a_goal_outside_the_limits_or_powered_off_is_never_pending() {
+        let (settings, mut bank) = at_rest();
+        // Joint 2's limit is 140 deg: about 3641 steps.
+        assert_eq!(
+            bank.send_goals(0, &settings, Goals::one(1, goal(4000))),
+            Err(AtomError::JointLimit(1))
+        );
+        assert!(bank.power(&settings, false));
+        assert_eq!(
+            bank.send_goals(0, &settings, Goals::one(0, goal(2100))),
+            Err(AtomError::PoweredOff)
+        );
+        assert_eq!(bank.take_goal_write(&settings), None);
+    }
+
+    #[test]
+    fn a_goal_lost_on_the_wire_is_repaired_at_most_three_times() {
+        let (settings, mut bank) = at_rest();
+        bank.send_goals(0, &settings, Goals::one(0, goal(2300)))
+            .unwrap();
+        assert!(bank.take_goal_write(&settings).is_some());
+        for repair in 0..readback::MAX_REPAIRS {
+            // The servo reports its old goal: the SYNC WRITE did not arrive.
+            read(&mut bank, &settings, 1_000, 0, state(1, 2048, 0, 2048));
+            assert!(
+                bank.take_goal_write(&settings).is_some(),
+                "repair {repair} re-sends the goal"
+            );
+        }
+        read(&mut bank, &settings, 1_000, 0, state(1, 2048, 0, 2048));
+        assert_eq!(bank.take_goal_write(&settings), None, "given up");
+        // A goal that arrived needs no repair.
+        bank.send_goals(0, &settings, Goals::one(0, goal(2400)))
+            .unwrap();
+        assert!(bank.take_goal_write(&settings).is_some());
+        read(&mut bank, &settings, 2_000, 0, state(1, 2048, 100, 2400));
+        assert_eq!(bank.take_goal_write(&settings), None);
+    }
+
+    #[test]
+    fn a_lost_torque_write_is_repaired() {
+        let (settings, mut bank) = at_rest();
+        assert!(bank.set_torque(&settings, 2, false));
+        assert!(bank.due_job().is_some(), "the torque write is queued");
+        let job = bank.due_job().unwrap();
+        assert_eq!(bank.finish(0, &settings, job, Outcome::Sent, false), None);
+        // The servo still reports torque on: the write got lost.
+        read(&mut bank, &settings, 1_000, 2, state(3, 2048, 0, 2048));
+        assert_eq!(
+            bank.due_job(),
+            Op::write(3, reg::TORQUE_ENABLE, &[0]),
+            "written again"
+        );
+    }
+
+    #[test]
+    fn a_read_with_a_ticket_comes_back_once_done_and_a_timeout_is_retried() {
+        let (settings, mut bank) = at_rest();
+        let op = Op::Read {
+            id: 4,
+            addr: 21,
+            count: 3,
+        };
+        assert!(bank.queue_read(op.clone(), Ticket(5)));
+        for _ in 0..settings.config().timing.retries {
+            assert_eq!(
+                bank.finish(0, &settings, op.clone(), Outcome::TimedOut, false),
+                None
+            );
+            assert_eq!(bank.due_job(), Some(op.clone()), "tried again");
+        }
+        let answer = Packet::new(4, 0, &[1, 2, 3]).unwrap();
+        let done = bank.finish(0, &settings, op, Outcome::Answered(answer.clone()), false);
+        assert_eq!(
+            done,
+            Some(Finished {
+                ticket: Ticket(5),
+                id: 4,
+                answer: Some(answer),
+            })
+        );
+        assert_eq!(bank.due_job(), None);
+    }
+
+    #[test]
+    fn present_angles_move_on_with_the_read_speed_at_the_time_asked() {
+        let settings = powered();
+        let bank = bank_read(&settings, 0, [2048; JOINTS], [1000, 0, 0, 0, 0, 0]);
+        let at = |now_us| bank.present_angles(now_us, &settings)[0];
+        assert_eq!(at(0), settings.angle(0, Steps(2048)));
+        // 1000 steps/s for 10 ms: 10 steps further.
+        assert_eq!(at(10_000), settings.angle(0, Steps(2058)));
+        assert!(bank.joints_moving(0));
+        assert!(bank.servo_moving(0, 0));
+    }
+
+    #[test]
+    fn a_servo_that_misses_reads_is_lost_and_probed_only_now_and_then() {
+        let (settings, mut bank) = at_rest();
+        let misses = settings.config().timing.misses_before_lost;
+        for _ in 0..misses {
+            // One round: the gripper (index 6) times out every time.
+            for i in 0..SERVOS {
+                let op = bank.next_refresh_op(&settings).unwrap();
+                let outcome = if i == GRIPPER {
+                    Outcome::TimedOut
+                } else {
+                    Outcome::Answered(state(op.id(), 2048, 0, 2048))
+                };
+                bank.finish(0, &settings, op, outcome, false);
+            }
+        }
+        assert!(!bank.health(GRIPPER).unwrap().answering);
+        let ids: heapless::Vec<u8, 64> = (0..6 * 7)
+            .map(|_| bank.next_refresh_op(&settings).unwrap().id())
+            .collect();
+        let probes = ids.iter().filter(|&&id| id == 7).count();
+        assert!(probes <= 1, "{ids:?}");
+    }
+}

@@ -628,3 +628,97 @@ fn dir(d: Direction) -> JogDirection {
         Direction::Positive => JogDirection::Positive,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::powered;
+    use crate::config::AtomConfig;
+    use crate::io::RecordingIo;
+    use crate::settings::Settings;
+
+    fn ask(parts: &mut Parts, code: u8, data: &[u8]) -> Option<std::vec::Vec<u8>> {
+        let frame = Frame::new(code, data).unwrap();
+        let reply = handle(parts, 0, &frame, Link::Usb, &mut RecordingIo::default())?;
+        assert_eq!(reply.cmd(), code, "a reply carries its request's CMD byte");
+        Some(reply.data().to_vec())
+    }
+
+    /// Send angle (0x21): joint 1 to `degrees` at 50 %.
+    fn send_angle_1(parts: &mut Parts, degrees: i16) -> Option<std::vec::Vec<u8>> {
+        let mut data = std::vec![1];
+        data.extend_from_slice(&(degrees * 100).to_be_bytes());
+        data.push(50);
+        ask(parts, cmd::SEND_ANGLE, &data)
+    }
+
+    #[test]
+    fn a_refused_motion_answers_00_and_records_its_code_for_0x07() {
+        let mut parts = Parts::new(powered());
+        assert_eq!(
+            send_angle_1(&mut parts, 170),
+            Some(std::vec![0]),
+            "J1 ends at 168 deg"
+        );
+        assert_eq!(
+            ask(&mut parts, cmd::GET_ERROR_INFO, &[]),
+            Some(std::vec![1])
+        );
+        assert!(!parts.motion.is_active(), "nothing moves");
+    }
+
+    #[test]
+    fn a_motion_while_powered_off_is_refused_without_an_error_code() {
+        let mut parts = Parts::new(Settings::new(AtomConfig::default()));
+        assert_eq!(send_angle_1(&mut parts, 10), Some(std::vec![0]));
+        assert_eq!(
+            ask(&mut parts, cmd::GET_ERROR_INFO, &[]),
+            Some(std::vec![0])
+        );
+    }
+
+    #[test]
+    fn an_accepted_motion_becomes_goals_for_the_servos() {
+        let mut parts = Parts::new(powered());
+        assert_eq!(send_angle_1(&mut parts, 10), Some(std::vec![1]));
+        assert!(parts.motion.is_active());
+        assert!(parts.bank.take_goal_write(&parts.settings).is_some());
+    }
+
+    #[test]
+    fn a_frame_setting_reads_back_as_set() {
+        let mut parts = Parts::new(powered());
+        let tool: std::vec::Vec<u8> = [100i16, 0, 500, 0, 0, 9_000]
+            .iter()
+            .flat_map(|v| v.to_be_bytes())
+            .collect();
+        assert_eq!(
+            ask(&mut parts, cmd::SET_TOOL_REFERENCE, &tool),
+            Some(std::vec![1])
+        );
+        assert_eq!(ask(&mut parts, cmd::GET_TOOL_REFERENCE, &[]), Some(tool));
+        assert_eq!(ask(&mut parts, cmd::SET_END_TYPE, &[1]), Some(std::vec![1]));
+        assert_eq!(ask(&mut parts, cmd::GET_END_TYPE, &[]), Some(std::vec![1]));
+    }
+
+    #[test]
+    fn a_servo_data_read_answers_later_through_the_bank() {
+        let mut parts = Parts::new(powered());
+        assert_eq!(ask(&mut parts, cmd::GET_SERVO_DATA, &[2, 56]), None);
+        assert_eq!(
+            parts.bank.due_job(),
+            Some(crate::driver::Op::Read {
+                id: 2,
+                addr: 56,
+                count: 1
+            })
+        );
+    }
+
+    #[test]
+    fn a_frame_that_is_no_valid_command_answers_00() {
+        let mut parts = Parts::new(powered());
+        assert_eq!(ask(&mut parts, 0xEE, &[]), Some(std::vec![0]));
+        assert_eq!(ask(&mut parts, cmd::SEND_ANGLE, &[1]), Some(std::vec![0]));
+    }
+}

@@ -94,3 +94,39 @@ fn gain_read(id: u8) -> Op {
         count: 3,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::{at_rest, powered, queued};
+
+    #[test]
+    fn set_writes_p_d_i_of_each_group_between_an_eeprom_unlock_and_lock() {
+        let (settings, mut bank) = at_rest();
+        assert_eq!(set(&mut bank, &settings, [1, 2, 3, 4, 5, 6]), Ok(()));
+        let ops = queued(&mut bank, &settings);
+        assert_eq!(ops.len(), SET_OPS);
+        assert!(matches!(ops[0], Op::Broadcast(_)), "unlock");
+        assert!(matches!(ops[SET_OPS - 1], Op::Broadcast(_)), "lock");
+        for (j, op) in ops[1..=JOINTS].iter().enumerate() {
+            let pdi: &[u8] = if j < GROUP_SIZE {
+                &[1, 3, 2]
+            } else {
+                &[4, 6, 5]
+            };
+            let id = u8::try_from(j + 1).unwrap();
+            assert_eq!(*op, Op::write(id, reg::P_COEFFICIENT, pdi).unwrap());
+        }
+    }
+
+    #[test]
+    fn get_answers_p_i_d_of_joints_1_and_4_and_255_for_a_silent_servo() {
+        let settings = powered();
+        let (ids, ops) = reads(&settings).unwrap();
+        assert_eq!(ids, [1, 4]);
+        assert_eq!(ops[1], gain_read(4));
+        let answer = Packet::new(1, 0, &[10, 30, 20]).unwrap();
+        let got = [group_gains(Some(&answer)), group_gains(None)];
+        assert_eq!(wire_bytes(got), [10, 20, 30, 255, 255, 255]);
+    }
+}

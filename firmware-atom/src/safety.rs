@@ -214,6 +214,21 @@ mod tests {
     }
 
     #[test]
+    fn newer_goals_merge_on_top_and_one_gives_a_single_servo_a_goal() {
+        let g = |position| Goal {
+            position: Steps(position),
+            speed_steps_per_s: 1,
+            accel: 1,
+        };
+        let older = Goals::one(0, g(1)).merge(&Goals::one(1, g(2)));
+        let merged = older.merge(&Goals::one(1, g(3)));
+        assert_eq!(merged.iter().collect::<Vec<_>>(), [(0, g(1)), (1, g(3))]);
+        assert_eq!(merged.get(2), None);
+        assert!(Goals::one(SERVOS, g(1)).is_empty(), "no such servo");
+        assert!(Goals::NONE.is_empty());
+    }
+
+    #[test]
     fn move_block_layout() {
         let g = Goal {
             position: Steps(3000),

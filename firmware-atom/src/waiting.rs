@@ -168,3 +168,92 @@ impl WaitingReads {
         Some((link, reply?))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use protocol_core::servo::Packet;
+
+    use super::*;
+    use crate::bank::test_support::at_rest;
+    use crate::driver::Outcome;
+
+    fn read(id: u8, addr: u8, count: u8) -> Op {
+        Op::Read { id, addr, count }
+    }
+
+    #[test]
+    fn each_read_and_reply_command_is_answered_through_complete() {
+        let (settings, mut bank) = at_rest();
+        let mut motion = MotionController::new();
+        let mut waiting = WaitingReads::default();
+        let word = WaitingRead::ServoData { two_bytes: true };
+        assert_eq!(
+            waiting.start(&mut bank, Link::Usb, word, &[read(2, 56, 2)]),
+            Ok(())
+        );
+        let pid = WaitingRead::Pid {
+            ids: [1, 4],
+            got: [None; 2],
+        };
+        let pid_reads = [read(1, 21, 3), read(4, 21, 3)];
+        assert_eq!(waiting.start(&mut bank, Link::Bus, pid, &pid_reads), Ok(()));
+        assert_eq!(
+            waiting.start(&mut bank, Link::Bus, pid, &pid_reads),
+            Err(AtomError::Busy),
+            "one get PID at a time"
+        );
+        let answers = [
+            Packet::new(2, 0, &[0x34, 0x12]),
+            Packet::new(1, 0, &[10, 30, 20]),
+            None,
+        ];
+        let mut replies = std::vec::Vec::new();
+        for answer in answers {
+            let op = bank.due_job().unwrap();
+            let outcome = answer.map_or(Outcome::TimedOut, Outcome::Answered);
+            for _ in 0..=settings.config().timing.retries {
+                if let Some(done) = bank.finish(0, &settings, op.clone(), outcome.clone(), false) {
+                    let cx = &mut Context::new(0, &mut bank, &settings);
+                    replies.push(waiting.complete(cx, &mut motion, None, done));
+                    break;
+                }
+            }
+        }
+        let servo_data = Frame::new(cmd::GET_SERVO_DATA, &[0x12, 0x34]).unwrap();
+        let gains = Reply::Bytes6([10, 20, 30, 255, 255, 255]).to_frame(cmd::GET_PID);
+        assert_eq!(
+            replies,
+            [
+                Some((Link::Usb, servo_data)),
+                None,
+                Some((Link::Bus, gains))
+            ],
+            "get PID answers once both reads are done, a silent servo as 255"
+        );
+        assert_eq!(waiting, WaitingReads::default(), "nobody waits any more");
+    }
+
+    #[test]
+    fn a_backup_answers_once_every_servo_is_in() {
+        let (settings, mut bank) = at_rest();
+        let mut motion = MotionController::new();
+        let mut waiting = WaitingReads::default();
+        let params = WaitingRead::Params {
+            restore: false,
+            waiting: 0b11,
+            ok: true,
+        };
+        let reads = [read(1, 9, 31), read(2, 9, 31)];
+        assert_eq!(waiting.start(&mut bank, Link::Bus, params, &reads), Ok(()));
+        let mut replies = std::vec::Vec::new();
+        for _ in 0..2 {
+            let op = bank.due_job().unwrap();
+            let block = Packet::new(op.id(), 0, &[0; 31]);
+            let done = bank.finish(0, &settings, op, Outcome::Answered(block.unwrap()), false);
+            let cx = &mut Context::new(0, &mut bank, &settings);
+            replies.push(waiting.complete(cx, &mut motion, None, done.unwrap()));
+        }
+        let failed = Frame::new(cmd::BACKUP_SERVO_PARAMS, &[0]).unwrap();
+        assert_eq!(replies, [None, Some((Link::Bus, failed))], "no store: 00");
+    }
+}

@@ -20,7 +20,7 @@ pub(super) const STATE_READ_LEN: u8 = reg::PRESENT_CURRENT + 2 - reg::TORQUE_ENA
 /// Corrective writes per servo and command when the read-back disagrees (a lost write is
 /// re-sent; a servo that keeps disagreeing, e.g. a goal clamped by its own position limits, is
 /// left alone after this many).
-const MAX_REPAIRS: u8 = 3;
+pub(super) const MAX_REPAIRS: u8 = 3;
 
 /// Applies a state read (registers 40..=70) to a servo's health.
 pub(super) fn apply_state(h: &mut ServoHealth, p: &Packet) {

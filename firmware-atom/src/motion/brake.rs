@@ -134,3 +134,46 @@ pub fn stop_one(cx: &Context<'_>, index: usize) -> Option<Goal> {
         accel: config.servo_accel_register(),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::{bank_read, powered};
+
+    #[test]
+    fn every_joint_brakes_in_proportion_to_its_speed_so_all_stop_together() {
+        let settings = powered();
+        let config = settings.config();
+        let mut bank = bank_read(&settings, 0, [2_048; JOINTS], [2_000, 1_000, -500, 0, 0, 0]);
+        let cx = Context::new(0, &mut bank, &settings);
+        let stop = Braking::of(&cx);
+        let a = i64::from(config.motion.servo_accel_steps_per_s2);
+        let brake_us = 2_000 * 1_000_000 / a;
+        assert_eq!(stop.duration_us, GOAL_LATENCY_US + brake_us as u64);
+        let goal = |j: usize| stop.goals[j].unwrap();
+        // The fastest joint at full deceleration, the others at their share of it.
+        assert_eq!(i64::from(goal(0).accel), (a + 99) / 100);
+        assert_eq!(i64::from(goal(1).accel), (a / 2 + 99) / 100);
+        assert_eq!(i64::from(goal(2).accel), (a / 4 + 99) / 100);
+        // Each comes to rest where its speed carries it: latency plus half the braking time.
+        for (j, v) in [(0, 2_000), (1, 1_000), (2, -500)] {
+            let travel = v * (GOAL_LATENCY_US as i64 + brake_us / 2) / 1_000;
+            let rest = (2_048_000 + travel + 500).div_euclid(1_000);
+            assert_eq!(i64::from(goal(j).position.0), rest, "joint {}", j + 1);
+            assert_eq!(stop.rest[j], settings.angle(j, Steps(rest as i16)));
+        }
+        assert_eq!(goal(3).position, Steps(2_048), "a joint at rest stays");
+        assert_eq!(goal(3).speed_steps_per_s, 50, "and settles at once");
+    }
+
+    #[test]
+    fn a_lone_servo_stops_at_full_deceleration() {
+        let settings = powered();
+        let mut bank = bank_read(&settings, 0, [2_048; JOINTS], [0, 0, 0, 0, 1_140, 0]);
+        let cx = Context::new(0, &mut bank, &settings);
+        let g = stop_one(&cx, 4).unwrap();
+        assert_eq!(g.accel, settings.config().servo_accel_register());
+        assert_eq!(g.speed_steps_per_s, 1_140);
+        assert!(g.position.0 > 2_048 + 50, "{g:?}");
+    }
+}

@@ -184,3 +184,82 @@ fn goal_position(settings: &Settings, j: usize, millisteps: i64) -> Steps {
     }
     settings.goal_steps(j, angle)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::at_rest;
+
+    const PERIOD_US: u64 = 20_000;
+
+    fn leg(target: [Centideg; JOINTS], last: bool) -> Leg {
+        Leg {
+            target,
+            period_us: PERIOD_US,
+            speed_cap_steps_per_s: 3_000,
+            pace: Pace::Free,
+            last,
+        }
+    }
+
+    #[test]
+    fn a_joint_gets_the_speed_to_its_target_and_a_goal_a_braking_distance_beyond() {
+        let (settings, mut bank) = at_rest();
+        let config = settings.config();
+        let cx = Context::new(0, &mut bank, &settings);
+        let mut target = [Centideg(0); JOINTS];
+        target[0] = settings.angle(0, Steps(2_068));
+        let goals = Follower::default().goals_towards(&cx, &leg(target, false));
+        let to = config.angle_to_millisteps(0, i32::from(target[0].0));
+        let speed = (to - 2_048_000) * 1000 / PERIOD_US as i64;
+        let g = goals.get(0).unwrap();
+        assert_eq!(i64::from(g.speed_steps_per_s), speed, "there in one period");
+        assert_eq!(
+            g.accel,
+            config.servo_accel_register(),
+            "free pace: full acceleration"
+        );
+        let braking = speed * speed * 1000 / (2 * i64::from(g.accel) * 100);
+        assert!(
+            i64::from(g.position.0) * 1000 >= to + braking,
+            "the goal lies beyond the target by at least the braking distance: {g:?}"
+        );
+        assert_eq!(
+            goals.get(1).unwrap().position,
+            Steps(2_048),
+            "a joint that stays"
+        );
+    }
+
+    #[test]
+    fn the_next_target_starts_from_where_the_joint_should_be_and_the_last_is_the_goal() {
+        let (settings, mut bank) = at_rest();
+        let cx = Context::new(0, &mut bank, &settings);
+        let mut follower = Follower::default();
+        let mut target = [Centideg(0); JOINTS];
+        target[0] = settings.angle(0, Steps(2_068));
+        let first = follower
+            .goals_towards(&cx, &leg(target, false))
+            .get(0)
+            .unwrap();
+        // The read still says 2048 (a few ms old): the follower expects the joint 20 steps on
+        // and asks for the next 20 steps, not for 40.
+        target[0] = settings.angle(0, Steps(2_088));
+        let second = follower
+            .goals_towards(&cx, &leg(target, false))
+            .get(0)
+            .unwrap();
+        let diff = i32::from(second.speed_steps_per_s) - i32::from(first.speed_steps_per_s);
+        assert!(diff.abs() < 300, "{first:?} then {second:?}");
+        let last = follower
+            .goals_towards(&cx, &leg(target, true))
+            .get(0)
+            .unwrap();
+        assert_eq!(
+            last.position,
+            Steps(2_088),
+            "the last target is the goal itself"
+        );
+        assert!(last.speed_steps_per_s >= 50);
+    }
+}

@@ -961,3 +961,134 @@ fn arrived(cx: &Context<'_>, target: &[Centideg; JOINTS]) -> bool {
     });
     tolerance::angles_match(&seen, target) && !cx.joints_moving()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::at_rest;
+    use crate::config::AtomConfig;
+    use crate::settings::Settings;
+
+    #[test]
+    fn every_new_motion_is_refused_while_powered_off() {
+        let settings = Settings::new(AtomConfig::default());
+        let mut bank = ServoBank::new(&settings);
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        let pose = settings.cart().forward(&[Centideg(0); JOINTS]);
+        let commands = [
+            Command::Move(Target::joint(0, Centideg(1_000), 50)),
+            Command::ToPose {
+                pose,
+                speed_percent: 50,
+                mode: MoveMode::Linear,
+            },
+            Command::Arc {
+                begin: None,
+                via: pose,
+                end: pose,
+                speed_percent: 50,
+            },
+            Command::JogJoint {
+                joint: 0,
+                direction: JogDirection::Positive,
+                speed_percent: 50,
+            },
+            Command::JogPose {
+                axis: 2,
+                direction: JogDirection::Negative,
+                speed_percent: 50,
+            },
+        ];
+        for command in commands {
+            assert_eq!(motion.command(cx, command), Err(AtomError::PoweredOff));
+        }
+        assert!(!motion.is_active());
+    }
+
+    #[test]
+    fn queue_mode_runs_the_moves_in_turn() {
+        let (mut settings, mut bank) = at_rest();
+        settings.set_fresh_mode(false);
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        let first = Target::joint(0, Centideg(1_000), 100);
+        let second = Target::joint(1, Centideg(500), 100);
+        assert_eq!(motion.command(cx, Command::Move(first)), Ok(()));
+        assert_eq!(motion.command(cx, Command::Move(second)), Ok(()));
+        assert_eq!(motion.planned_angles(cx)[0], Centideg(1_000));
+        assert_eq!(
+            motion.planned_angles(cx)[1],
+            Centideg(0),
+            "the second waits"
+        );
+        // The servos never report arriving here: the first move ends after its overtime.
+        cx.now_us = 10 * MOVE_OVERTIME_US;
+        assert_eq!(motion.update(cx), Ok(()));
+        assert_eq!(motion.planned_angles(cx)[1], Centideg(500), "its turn");
+        let held = settings.angle(0, settings.goal_steps(0, Centideg(1_000)));
+        assert_eq!(motion.planned_angles(cx)[0], held, "joint 1 holds its goal");
+    }
+
+    #[test]
+    fn a_fresh_move_replaces_a_running_one_after_braking() {
+        let (settings, mut bank) = at_rest();
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        let first = Target::joint(0, Centideg(1_000), 100);
+        let second = Target::joint(1, Centideg(500), 100);
+        assert_eq!(motion.command(cx, Command::Move(first)), Ok(()));
+        cx.now_us = 200_000;
+        assert_eq!(motion.command(cx, Command::Move(second)), Ok(()));
+        assert!(matches!(motion.activity, Activity::Braking { .. }));
+        assert_eq!(motion.planned_angles(cx)[1], Centideg(500));
+        cx.now_us = 400_000;
+        assert_eq!(motion.update(cx), Ok(()));
+        assert!(matches!(motion.activity, Activity::Joint { .. }), "started");
+    }
+
+    #[test]
+    fn stop_brakes_and_forgets_the_queued_moves() {
+        let (mut settings, mut bank) = at_rest();
+        settings.set_fresh_mode(false);
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        for j in 0..3 {
+            let target = Target::joint(j, Centideg(1_000), 100);
+            assert_eq!(motion.command(cx, Command::Move(target)), Ok(()));
+        }
+        motion.stop(cx);
+        assert!(matches!(
+            motion.activity,
+            Activity::Braking { then: None, .. }
+        ));
+        cx.now_us = 10 * MOVE_OVERTIME_US;
+        assert_eq!(motion.update(cx), Ok(()));
+        assert!(!motion.is_active(), "nothing queued starts");
+    }
+
+    #[test]
+    fn a_jog_stops_when_the_host_falls_silent() {
+        let (settings, mut bank) = at_rest();
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        let jog = Command::JogJoint {
+            joint: 0,
+            direction: JogDirection::Positive,
+            speed_percent: 50,
+        };
+        motion.note_host_command(0);
+        assert_eq!(motion.command(cx, jog), Ok(()));
+        assert!(motion.jogging());
+        let watchdog_us = settings.config().timing.jog_watchdog_us;
+        cx.now_us = watchdog_us - 1;
+        assert_eq!(motion.update(cx), Ok(()));
+        assert!(motion.jogging());
+        cx.now_us = watchdog_us;
+        assert_eq!(motion.update(cx), Ok(()));
+        assert!(
+            matches!(motion.activity, Activity::Braking { .. }),
+            "stopped"
+        );
+    }
+}
