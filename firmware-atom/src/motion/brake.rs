@@ -20,7 +20,7 @@ const SETTLE_SPEED_STEPS_PER_S: u64 = 50;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Braking {
     /// The stopping goal of each joint that holds torque.
-    pub goals: [Option<Goal>; JOINTS],
+    pub goals: Goals,
     /// Where each joint comes to rest (its present angle if it holds no torque).
     pub rest: [Centideg; JOINTS],
     /// Time from now until every joint is at rest, microseconds.
@@ -49,7 +49,7 @@ impl Braking {
             .max()
             .unwrap_or(0);
         let brake_us = v_max * 1_000_000 / a;
-        let mut goals = [None; JOINTS];
+        let mut goals = Goals::NONE;
         let present: [Centideg; JOINTS] = core::array::from_fn(|j| {
             config.millisteps_to_angle(j, bank.last_known_millisteps(now_us, j))
         });
@@ -72,16 +72,15 @@ impl Braking {
             } else {
                 ((a * v.abs() + v_max * 100 - 1) / (v_max * 100)).clamp(1, 254) as u8
             };
-            if let Some(slot) = goals.get_mut(j) {
-                *slot = Some(Goal {
-                    position: settings.goal_steps(j, angle),
-                    speed_steps_per_s: v
-                        .unsigned_abs()
-                        .clamp(SETTLE_SPEED_STEPS_PER_S, u64::from(u16::MAX))
-                        as u16,
-                    accel,
-                });
-            }
+            let goal = Goal {
+                position: settings.goal_steps(j, angle),
+                speed_steps_per_s: v
+                    .unsigned_abs()
+                    .clamp(SETTLE_SPEED_STEPS_PER_S, u64::from(u16::MAX))
+                    as u16,
+                accel,
+            };
+            goals.set(j, Some(goal));
             if let Some(r) = rest.get_mut(j) {
                 *r = angle;
             }
@@ -97,10 +96,8 @@ impl Braking {
     /// stands outside its limits after being moved by hand) keeps its previous goal, and the
     /// others still stop.
     pub fn send(&self, cx: &mut Context<'_>) {
-        for (j, goal) in self.goals.iter().enumerate() {
-            if let Some(g) = goal {
-                let _ = cx.send_goals(Goals::one(j, *g));
-            }
+        for (j, goal) in self.goals.iter() {
+            let _ = cx.send_goals(Goals::one(j, goal));
         }
     }
 }
@@ -150,7 +147,7 @@ mod tests {
         let a = i64::from(config.motion.servo_accel_steps_per_s2);
         let brake_us = 2_000 * 1_000_000 / a;
         assert_eq!(stop.duration_us, GOAL_LATENCY_US + brake_us as u64);
-        let goal = |j: usize| stop.goals[j].unwrap();
+        let goal = |j: usize| stop.goals.get(j).unwrap();
         // The fastest joint at full deceleration, the others at their share of it.
         assert_eq!(i64::from(goal(0).accel), (a + 99) / 100);
         assert_eq!(i64::from(goal(1).accel), (a / 2 + 99) / 100);
