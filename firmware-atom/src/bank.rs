@@ -137,6 +137,18 @@ impl ServoBank {
         (0..SERVOS).all(|i| self.set_torque(settings, i, on))
     }
 
+    /// Switches torque back on for every servo released since the arm was powered on (power
+    /// on, 0x10, while already on). False if an operation did not fit.
+    pub fn focus_released(&mut self, settings: &Settings) -> bool {
+        let mut ok = true;
+        for i in 0..SERVOS {
+            if !self.enabled(i) {
+                ok &= self.set_torque(settings, i, true);
+            }
+        }
+        ok
+    }
+
     /// What the Atom knows about servo `index` (0..6 = joints 1..6, 6 = gripper).
     pub fn health(&self, index: usize) -> Option<&ServoHealth> {
         self.servos.get(index).map(|s| &s.health)

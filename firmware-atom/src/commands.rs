@@ -32,10 +32,6 @@ const SYSTEM_VERSION_X10: u8 = 70;
 /// Reported by get modify version (0x01).
 const MODIFY_VERSION: u8 = 0;
 
-/// What get servo status (0xE4) reports for a servo that does not answer: every bit set, a
-/// value no answering servo reports (its status register has six fault bits).
-const NO_ANSWER_STATUS: u8 = 0xFF;
-
 /// Handles one request; returns the reply (none only when the reply waits for the bus).
 pub(crate) fn handle<I: AtomIo>(
     parts: &mut Parts,
@@ -123,15 +119,8 @@ fn execute<I: AtomIo>(
         R::PowerOn => {
             settings.set_free_mode(false);
             if bank.powered() {
-                // Already on (the Basic says so at its boot): a running move goes on; only
-                // a servo released since gets its torque back.
-                let mut ok = true;
-                for i in 0..SERVOS {
-                    if !bank.enabled(i) {
-                        ok &= bank.set_torque(settings, i, true);
-                    }
-                }
-                return done_if(ok);
+                // Already on (the Basic says so at its boot): a running move goes on.
+                return done_if(bank.focus_released(settings));
             }
             let ok = bank.power(settings, true);
             // Hold where the arm is now instead of jumping to an old goal.
@@ -464,18 +453,11 @@ fn execute<I: AtomIo>(
             }
         },
         R::GetServoSpeeds => Answer::Now(Reply::Int16x6(bank.per_joint(|h| h.speed_steps_per_s))),
-        R::GetServoCurrents => Answer::Now(Reply::Int16x6(bank.per_joint(|h| {
-            // The STS current register counts 6.5 mA units.
-            (i32::from(h.current_raw) * 65 / 10).clamp(-32_768, 32_767) as i16
-        }))),
+        R::GetServoCurrents => Answer::Now(Reply::Int16x6(
+            bank.per_joint(ServoHealth::current_milliamps),
+        )),
         R::GetServoVoltages => Answer::Now(Reply::Bytes6(bank.per_joint(|h| h.voltage_decivolt))),
-        R::GetServoStatus => Answer::Now(Reply::Bytes6(bank.per_joint(|h| {
-            if h.answering {
-                h.fault_bits
-            } else {
-                NO_ANSWER_STATUS
-            }
-        }))),
+        R::GetServoStatus => Answer::Now(Reply::Bytes6(bank.per_joint(ServoHealth::status_byte))),
         R::GetServoTemps => Answer::Now(Reply::Bytes6(bank.per_joint(|h| h.temperature_c))),
         R::BackupServoParams { servo } | R::RestoreServoParams { servo } => {
             let restore = matches!(request, R::RestoreServoParams { .. });
