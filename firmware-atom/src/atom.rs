@@ -1,14 +1,15 @@
-//! The Atom: its parts side by side, lent to each other for one step in [`Atom::poll`].
+//! The Atom: its parts ([`Parts`]) side by side, run in [`Atom::poll`]; each step lends the
+//! servo bank and the settings to the part that acts through one [`Context`].
 //!
-//! * [`Settings`]: what the host set (limits, modes, frames).
-//! * [`ServoBank`]: the servos' state and the goals sent to them (the only maker of goals,
-//!   through the safety check).
-//! * [`MotionController`]: moves, paths, streams, jogs, braking, the queue.
-//! * [`Gripper`]: the gripper's range and settings.
-//! * [`DragRecorder`]: drag teaching, fed from the bank's state reads.
-//! * [`Gains`]: the servos' position-loop gains (0x2C / 0x2D).
-//! * [`Dispenser`]: the accessory hobby servo (0xD4 / 0xD7).
-//! * [`ErrorLog`]: the error state 0x07 reports.
+//! * [`crate::settings::Settings`]: what the host set (limits, modes, frames).
+//! * [`crate::bank::ServoBank`]: the servos' state and the goals sent to them (the only maker
+//!   of goals, through the safety check).
+//! * [`crate::motion::MotionController`]: moves, paths, streams, jogs, braking, the queue.
+//! * [`crate::gripper::Gripper`]: the gripper's range and settings.
+//! * [`crate::drag::DragRecorder`]: drag teaching, fed from the bank's state reads.
+//! * [`crate::dispenser::Dispenser`]: the accessory hobby servo (0xD4 / 0xD7).
+//! * [`crate::error::ErrorLog`]: the error state 0x07 reports.
+//! * [`crate::waiting::WaitingReads`]: requests whose replies wait for servo reads.
 //! * [`BusSchedule`]: who talks on the shared wire when; [`UsbLink`]: the Atom's own USB.
 //!
 //! [`crate::commands`] translates each request into calls on these parts.
@@ -16,47 +17,20 @@
 use protocol_core::units::{Centideg, Steps};
 use protocol_core::{BytePort, Frame};
 
-use crate::backup::Backups;
-use crate::bank::{Completion, ServoBank};
-use crate::config::{AtomConfig, ConfigError, GRIPPER, JOINTS, JointLimit};
-use crate::dispenser::Dispenser;
-use crate::drag::DragRecorder;
-use crate::error::ErrorLog;
-use crate::gains::Gains;
-use crate::gripper::Gripper;
-use crate::health::ServoHealth;
+use crate::config::{AtomConfig, ConfigError, JOINTS, JointLimit};
+use crate::context::Context;
+use crate::driver::{Op, Outcome};
 use crate::io::AtomIo;
 use crate::link::{Link, READ_BUDGET, UsbLink};
-use crate::motion::MotionController;
+use crate::parts::Parts;
 use crate::schedule::{BusEvent, BusSchedule};
 use crate::settings::Settings;
-
-/// The parts a command acts on.
-#[derive(Clone, Debug)]
-pub(crate) struct Parts {
-    /// What the host set.
-    pub settings: Settings,
-    /// The servos.
-    pub bank: ServoBank,
-    /// The motion.
-    pub motion: MotionController,
-    /// The gripper.
-    pub gripper: Gripper,
-    /// Drag teaching.
-    pub drag: DragRecorder,
-    /// The servos' gains.
-    pub gains: Gains,
-    /// The accessory servo.
-    pub dispenser: Dispenser,
-    /// The error state (0x07).
-    pub errors: ErrorLog,
-    /// Servo parameter backups (0xEA/0xEB).
-    pub backups: Backups,
-}
 
 /// The Atom firmware. Create it once with [`Atom::new`] and call [`Atom::poll`] in a loop.
 pub struct Atom {
     parts: Parts,
+    /// The time of the last poll: what the accessors below answer as of.
+    polled_us: u64,
     schedule: BusSchedule,
     usb: UsbLink,
     button_was_pressed: bool,
@@ -71,19 +45,9 @@ impl Atom {
             Ok(()) => (config, None),
             Err(e) => (AtomConfig::default(), Some(e)),
         };
-        let settings = Settings::new(config);
         Self {
-            parts: Parts {
-                bank: ServoBank::new(&settings),
-                motion: MotionController::new(),
-                gripper: Gripper::new(&settings),
-                drag: DragRecorder::new(),
-                gains: Gains::default(),
-                dispenser: Dispenser::default(),
-                errors: ErrorLog::default(),
-                backups: Backups::default(),
-                settings,
-            },
+            parts: Parts::new(Settings::new(config)),
+            polled_us: 0,
             schedule: BusSchedule::new(config.timing.reply_margin_us),
             usb: UsbLink::new(),
             button_was_pressed: false,
@@ -102,7 +66,7 @@ impl Atom {
         usb: &mut U,
         io: &mut I,
     ) {
-        self.parts.bank.set_time(now_us);
+        self.polled_us = now_us;
         for _ in 0..READ_BUDGET {
             let Some(byte) = bus.read_byte() else { break };
             for event in self.schedule.hear(now_us, byte) {
@@ -116,15 +80,11 @@ impl Atom {
         if let Some((op, outcome)) = self.schedule.poll_driver(now_us, bus) {
             self.finish(now_us, op, outcome, usb, io);
         }
-        let Parts {
-            settings,
-            bank,
-            motion,
-            errors,
-            ..
-        } = &mut self.parts;
-        let moved = motion.update(now_us, bank, settings);
-        errors.note(moved).ok();
+        let p = &mut self.parts;
+        let moved = p
+            .motion
+            .update(&mut Context::new(now_us, &mut p.bank, &p.settings));
+        p.errors.note(moved).ok();
         self.parts.drag.poll(now_us, &self.parts.bank);
         self.parts.dispenser.poll(now_us, io);
         self.update_button(now_us, io);
@@ -181,40 +141,29 @@ impl Atom {
         }
     }
 
-    /// Applies the result of a finished servo transaction; sends a reply that waited for it.
+    /// Applies the result of a finished servo transaction; sends a reply that waited for it
+    /// (the one completion path, [`crate::waiting`]).
     fn finish<U: BytePort, I: AtomIo>(
         &mut self,
         now_us: u64,
-        op: crate::driver::Op,
-        outcome: crate::driver::Outcome,
+        op: Op,
+        outcome: Outcome,
         usb: &mut U,
         io: &mut I,
     ) {
         let corrupt = self.schedule.saw_corruption();
         let p = &mut self.parts;
-        let finished = p
-            .bank
-            .finish(&p.settings, op.clone(), outcome.clone(), corrupt);
-        let retrying = p.bank.due_job().as_ref() == Some(&op);
-        let gains = p.gains.finished(&op, &outcome, retrying);
-        let reply = match finished {
-            Some(Completion::Reply { link, reply }) => Some((link, reply)),
-            Some(Completion::Params { index, block }) => p.backups.on_block(
-                now_us,
-                index,
-                block,
-                io.param_store(),
-                &mut p.bank,
-                &mut p.motion,
-                &p.settings,
-            ),
-            None => None,
+        let Some(done) = p.bank.finish(now_us, &p.settings, op, outcome, corrupt) else {
+            return;
         };
-        for (link, reply) in reply.into_iter().chain(gains) {
-            match link {
-                Link::Bus => self.schedule.send_reply(reply),
-                Link::Usb => usb.write(&reply.to_bytes()),
-            }
+        let cx = &mut Context::new(now_us, &mut p.bank, &p.settings);
+        let reply = p
+            .waiting
+            .complete(cx, &mut p.motion, io.param_store(), done);
+        match reply {
+            Some((Link::Bus, reply)) => self.schedule.send_reply(reply),
+            Some((Link::Usb, reply)) => usb.write(&reply.to_bytes()),
+            None => {}
         }
     }
 
@@ -252,7 +201,7 @@ impl Atom {
 
     /// True while the arm moves (a motion runs or a joint reports moving).
     pub fn is_moving(&self) -> bool {
-        crate::commands::is_moving(&self.parts)
+        self.parts.is_moving(self.polled_us)
     }
 
     /// The error code 0x07 reports (0 = none).
@@ -260,14 +209,11 @@ impl Atom {
         self.parts.errors.code()
     }
 
-    /// What the Atom knows about servo `index` (0..6 = joints 1..6, 6 = gripper).
-    pub fn servo_health(&self, index: usize) -> Option<&ServoHealth> {
-        self.parts.bank.health(index)
-    }
-
     /// Present joint angles, from the servos' last reported positions.
     pub fn present_angles(&self) -> [Centideg; JOINTS] {
-        self.parts.bank.present_angles(&self.parts.settings)
+        self.parts
+            .bank
+            .present_angles(self.polled_us, &self.parts.settings)
     }
 
     /// Present encoder positions of the joints.
@@ -288,11 +234,6 @@ impl Atom {
     /// Gripper opening 0 (closed) ..= 100 (open) from its present position.
     pub fn gripper_value(&self) -> u8 {
         self.parts.gripper.value(&self.parts.bank)
-    }
-
-    /// True while the gripper servo moves.
-    pub fn gripper_moving(&self) -> bool {
-        self.parts.bank.servo_moving(GRIPPER)
     }
 
     /// The coordinate frames the host selected (tool pose, world pose, reference frame, end

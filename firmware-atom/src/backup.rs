@@ -5,8 +5,8 @@
 //! PID, start-up force, dead zones, protection settings, homing offset, operating mode, speed
 //! loop gains: what a replaced or corrupted servo needs), and stores it under the servo's id in
 //! a wear-levelled flash store ([`ParamStore`], `flash_store` on the board and in the virtual
-//! robot). It survives a power cycle. The reply comes when every block is read and stored: `01`,
-//! or `00` if a servo did not answer or the flash failed.
+//! robot). It survives a power cycle. The reply waits for every block to be read and stored
+//! ([`crate::waiting`]): `01`, or `00` if a servo did not answer or the flash failed.
 //!
 //! A restore writes a stored block back (EEPROM unlocked and locked around it), after the same
 //! checks as any raw write: never the id, baud rate, return delay or status return level (they
@@ -20,17 +20,14 @@ use core::ops::Range;
 
 use embedded_storage::nor_flash::NorFlash;
 use flash_store::{FlashRange, StoreError};
-use protocol_core::Frame;
-use protocol_core::command::{ServoSelect, cmd};
-use protocol_core::servo::reg;
+use protocol_core::command::ServoSelect;
+use protocol_core::servo::{Packet, reg};
 
-use crate::bank::{ServoBank, Then};
-use crate::config::{JOINTS, SERVOS};
+use crate::config::JOINTS;
+use crate::context::Context;
 use crate::driver::Op;
 use crate::error::AtomError;
-use crate::link::Link;
 use crate::motion::MotionController;
-use crate::settings::Settings;
 
 /// First register of the parameter block.
 pub const BLOCK_ADDR: u8 = reg::MIN_POSITION;
@@ -92,142 +89,83 @@ impl<F: NorFlash> ParamStore for FlashParams<F> {
     }
 }
 
-/// What the running backup or restore is waiting for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Job {
-    Backup,
-    Restore,
-}
-
-/// A backup or restore waiting for the servos' blocks to be read.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Pending {
-    job: Job,
-    link: Link,
-    /// Servos (bit per index) still to be read.
-    waiting: u8,
-    ok: bool,
-}
-
-/// The backup and restore of servo parameters. See the [module doc](self).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Backups {
-    pending: Option<Pending>,
-}
-
-impl Backups {
-    /// Starts a backup (0xEA) or restore (0xEB) of `servos` for a request from `link`: reads
-    /// each servo's present block; the reply follows when all are in ([`Self::on_block`]).
-    /// Refused while another one runs, or with no store (`has_store`).
-    pub fn start(
-        &mut self,
-        restore: bool,
-        servos: ServoSelect,
-        link: Link,
-        has_store: bool,
-        bank: &mut ServoBank,
-        settings: &Settings,
-    ) -> Result<(), AtomError> {
-        if !has_store {
-            return Err(AtomError::Invalid);
-        }
-        if self.pending.is_some() {
-            return Err(AtomError::Busy);
-        }
-        let indices = match servos {
-            ServoSelect::All => 0..JOINTS,
-            ServoSelect::One(s) => {
-                let i = usize::from(s.get()) - 1;
-                i..i + 1
-            }
-        };
-        // A restore writes three operations per servo afterwards.
-        if bank.op_room() < indices.len() * 4 {
-            return Err(AtomError::Busy);
-        }
-        let mut waiting = 0u8;
-        for i in indices {
-            let id = *settings
-                .config()
-                .servo_ids
-                .get(i)
-                .ok_or(AtomError::Invalid)?;
-            let read = Op::Read {
-                id,
-                addr: BLOCK_ADDR,
-                count: BLOCK_LEN as u8,
-            };
-            if !bank.queue_op(read, Then::Backup) {
-                return Err(AtomError::Busy);
-            }
-            waiting |= 1 << i;
-        }
-        self.pending = Some(Pending {
-            job: if restore { Job::Restore } else { Job::Backup },
-            link,
-            waiting,
-            ok: true,
-        });
-        Ok(())
+/// The reads of a backup (0xEA) or restore (0xEB) of `servos`: each servo's present block,
+/// and the servos read (a bit per index). Refused with no store (`has_store`), or without room
+/// in the bank's queue for a restore's writes afterwards (three operations per servo).
+pub fn reads(
+    cx: &Context<'_>,
+    servos: ServoSelect,
+    has_store: bool,
+) -> Result<(heapless::Vec<Op, JOINTS>, u8), AtomError> {
+    if !has_store {
+        return Err(AtomError::Invalid);
     }
+    let indices = match servos {
+        ServoSelect::All => 0..JOINTS,
+        ServoSelect::One(s) => {
+            let i = usize::from(s.get()) - 1;
+            i..i + 1
+        }
+    };
+    if cx.bank.op_room() < indices.len() * 4 {
+        return Err(AtomError::Busy);
+    }
+    let mut ops = heapless::Vec::new();
+    let mut servos = 0u8;
+    for i in indices {
+        let id = *cx
+            .settings
+            .config()
+            .servo_ids
+            .get(i)
+            .ok_or(AtomError::Invalid)?;
+        let read = Op::Read {
+            id,
+            addr: BLOCK_ADDR,
+            count: BLOCK_LEN as u8,
+        };
+        ops.push(read).map_err(|_| AtomError::Busy)?;
+        servos |= 1 << i;
+    }
+    Ok((ops, servos))
+}
 
-    /// Takes servo `index`'s present block (`None`: it did not answer). A backup stores it; a
-    /// restore writes the stored one back. Returns the reply once every servo is done.
-    #[allow(clippy::too_many_arguments)]
-    pub fn on_block(
-        &mut self,
-        now_us: u64,
-        index: usize,
-        present: Option<Block>,
-        store: Option<&mut dyn ParamStore>,
-        bank: &mut ServoBank,
-        motion: &mut MotionController,
-        settings: &Settings,
-    ) -> Option<(Link, Frame)> {
-        let pending = self.pending.as_mut()?;
-        if index >= SERVOS || pending.waiting & (1 << index) == 0 {
-            return None;
-        }
-        pending.waiting &= !(1 << index);
-        let id = settings.config().servo_ids.get(index).copied();
-        let done = match (present, store, id) {
-            (Some(block), Some(store), Some(id)) => match pending.job {
-                Job::Backup => store.save(id, &block).is_ok(),
-                Job::Restore => match store.load(id) {
-                    Ok(Some(saved)) => {
-                        restore(now_us, index, id, &block, &saved, bank, motion, settings)
-                    }
-                    _ => false,
-                },
-            },
+/// Servo `index`'s parameter block from its answer to the read of [`reads`]; `None` if it did
+/// not answer.
+pub fn block(answer: Option<&Packet>) -> Option<Block> {
+    answer.and_then(|p| p.params().try_into().ok())
+}
+
+/// Takes servo `index`'s present block (`None`: it did not answer): a backup stores it, a
+/// restore writes the stored one back. True if that worked.
+pub fn take_block(
+    cx: &mut Context<'_>,
+    motion: &mut MotionController,
+    store: Option<&mut dyn ParamStore>,
+    restoring: bool,
+    index: usize,
+    present: Option<Block>,
+) -> bool {
+    let id = cx.settings.config().servo_ids.get(index).copied();
+    match (present, store, id) {
+        (Some(block), Some(store), Some(id)) if !restoring => store.save(id, &block).is_ok(),
+        (Some(block), Some(store), Some(id)) => match store.load(id) {
+            Ok(Some(saved)) => restore(cx, motion, index, id, &block, &saved),
             _ => false,
-        };
-        pending.ok &= done;
-        if pending.waiting != 0 {
-            return None;
-        }
-        let finished = self.pending.take()?;
-        let code = if finished.job == Job::Backup {
-            cmd::BACKUP_SERVO_PARAMS
-        } else {
-            cmd::RESTORE_SERVO_PARAMS
-        };
-        Some((finished.link, Frame::new(code, &[u8::from(finished.ok)])?))
+        },
+        _ => false,
     }
 }
 
 /// Writes `saved` back to servo `index` (bus id `id`) whose block is `present` now. See the
 /// [module doc](self).
-#[allow(clippy::too_many_arguments)]
 fn restore(
-    now_us: u64,
+    cx: &mut Context<'_>,
+    motion: &mut MotionController,
     index: usize,
     id: u8,
     present: &Block,
     saved: &Block,
-    bank: &mut ServoBank,
-    motion: &mut MotionController,
-    settings: &Settings,
 ) -> bool {
     if saved.get(MODE_AT) != Some(&0) {
         return false;
@@ -236,9 +174,9 @@ fn restore(
     if present.get(offset.clone()) != saved.get(offset) {
         // The zero moves: the servo would jump to its old goal in the new frame.
         if index < JOINTS {
-            motion.halt(now_us, bank, settings);
+            motion.halt(cx);
         }
-        if !bank.set_torque(settings, index, false) {
+        if !cx.bank.set_torque(cx.settings, index, false) {
             return false;
         }
     }
@@ -247,9 +185,110 @@ fn restore(
         Op::write(id, BLOCK_ADDR, saved),
         Op::write(id, reg::EEPROM_LOCK, &[1]),
     ];
-    if bank.op_room() < ops.len() {
+    if cx.bank.op_room() < ops.len() {
         return false;
     }
     ops.into_iter()
-        .all(|op| op.is_some_and(|op| bank.queue_op(op, Then::Nothing)))
+        .all(|op| op.is_some_and(|op| cx.bank.queue_op(op)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::{at_rest, queued};
+
+    /// Blocks kept in memory.
+    #[derive(Default)]
+    struct Memory(std::vec::Vec<(u8, Block)>);
+
+    impl ParamStore for Memory {
+        fn load(&mut self, id: u8) -> Result<Option<Block>, StoreError> {
+            Ok(self.0.iter().find(|(i, _)| *i == id).map(|(_, b)| *b))
+        }
+        fn save(&mut self, id: u8, block: &Block) -> Result<(), StoreError> {
+            self.0.retain(|(i, _)| *i != id);
+            self.0.push((id, *block));
+            Ok(())
+        }
+    }
+
+    /// A block in position mode, every other byte `fill`, the homing offset `homing_offset`.
+    fn block(fill: u8, homing_offset: u8) -> Block {
+        let mut b = [fill; BLOCK_LEN];
+        b[MODE_AT] = 0;
+        b[HOMING_OFFSET_AT] = homing_offset;
+        b[HOMING_OFFSET_AT + 1] = 0;
+        b
+    }
+
+    /// Takes `present` as joint 2's block (bus id 2) for a backup or a restore, with `saved`
+    /// in the store: whether that worked, what it queued, whether the joint still holds torque,
+    /// and the store.
+    fn take_joint_2(
+        restoring: bool,
+        saved: Option<Block>,
+        present: Option<Block>,
+    ) -> (bool, std::vec::Vec<Op>, bool, Memory) {
+        let (settings, mut bank) = at_rest();
+        let mut store = Memory::default();
+        if let Some(saved) = saved {
+            store.save(2, &saved).unwrap();
+        }
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        let mut motion = MotionController::new();
+        let ok = take_block(cx, &mut motion, Some(&mut store), restoring, 1, present);
+        let ops = queued(&mut bank, &settings);
+        (ok, ops, bank.enabled(1), store)
+    }
+
+    #[test]
+    fn a_backup_stores_the_block_under_the_servo_id() {
+        let (ok, ops, _, mut store) = take_joint_2(false, None, Some(block(7, 0)));
+        assert!(ok && ops.is_empty());
+        assert_eq!(store.load(2), Ok(Some(block(7, 0))));
+        assert!(!take_joint_2(false, None, None).0, "no answer");
+    }
+
+    #[test]
+    fn a_restore_writes_the_saved_block_back_with_the_eeprom_open() {
+        let (ok, ops, holds, _) = take_joint_2(true, Some(block(9, 0)), Some(block(4, 0)));
+        assert!(ok);
+        assert_eq!(
+            ops,
+            [
+                Op::write(2, reg::EEPROM_LOCK, &[0]).unwrap(),
+                Op::write(2, BLOCK_ADDR, &block(9, 0)).unwrap(),
+                Op::write(2, reg::EEPROM_LOCK, &[1]).unwrap(),
+            ]
+        );
+        assert!(holds, "the zero stayed: the servo holds on");
+    }
+
+    #[test]
+    fn a_restore_that_moves_the_zero_releases_the_servo_first() {
+        let (ok, ops, holds, _) = take_joint_2(true, Some(block(9, 30)), Some(block(9, 0)));
+        assert!(ok);
+        assert_eq!(ops[0], Op::write(2, reg::TORQUE_ENABLE, &[0]).unwrap());
+        assert_eq!(ops.len(), 4);
+        assert!(!holds);
+    }
+
+    #[test]
+    fn a_restore_needs_a_backup_in_position_mode() {
+        let (ok, ops, _, _) = take_joint_2(true, None, Some(block(9, 0)));
+        assert!(!ok && ops.is_empty(), "no backup");
+        let mut wheel = block(9, 0);
+        wheel[MODE_AT] = 1;
+        let (ok, ops, _, _) = take_joint_2(true, Some(wheel), Some(block(9, 0)));
+        assert!(!ok && ops.is_empty(), "not in position mode");
+    }
+
+    #[test]
+    fn the_reads_cover_the_servos_asked_for_with_room_for_the_writes() {
+        let (settings, mut bank) = at_rest();
+        let cx = Context::new(0, &mut bank, &settings);
+        let (ops, servos) = reads(&cx, ServoSelect::All, true).unwrap();
+        assert_eq!((ops.len(), servos), (JOINTS, 0b11_1111));
+        assert_eq!(reads(&cx, ServoSelect::All, false), Err(AtomError::Invalid));
+    }
 }

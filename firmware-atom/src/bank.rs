@@ -7,18 +7,16 @@
 //! torque and goal registers, and a write that did not arrive is sent again ([`readback`]).
 
 use heapless::Deque;
-use protocol_core::Frame;
-use protocol_core::command::cmd;
-use protocol_core::servo::reg;
+use protocol_core::servo::{Packet, reg};
 use protocol_core::units::{Centideg, Steps};
 
 use crate::config::{GRIPPER, JOINTS, SERVOS, STEPS_ZERO};
 use crate::driver::{Op, Outcome};
 use crate::error::AtomError;
 use crate::health::ServoHealth;
-use crate::link::Link;
-use crate::safety::{self, Goal, GoalSet, SafeGoals};
+use crate::safety::{self, Goal, Goals, SafeGoals};
 use crate::settings::Settings;
+use crate::tolerance;
 
 mod readback;
 
@@ -40,9 +38,6 @@ const HOLD_SPEED_PERCENT: u8 = 10;
 /// several refresh rounds (a round takes about 3 ms).
 const GOAL_CONFIRM_US: u64 = 30_000;
 
-/// Distance from its goal within which a servo counts as arrived: 10 steps, under one degree.
-const IN_POSITION_STEPS: i32 = 10;
-
 /// How long a stop still trusts the last state read of a servo whose reads are being lost (its
 /// answers late or garbled: a busy bus, a slow or emulated Atom): it holds torque and goes on
 /// doing what it last did, so a stop extrapolates its last read speed for up to this long.
@@ -50,47 +45,45 @@ const IN_POSITION_STEPS: i32 = 10;
 /// a few reads costs, and an older read says nothing about where the joint is.
 const STALE_STATE_US: u64 = 500_000;
 
-/// What to do when a queued servo operation finishes.
+/// Who waits for a queued servo operation's result. Opaque to the bank: it hands the ticket
+/// back with the result ([`Finished`]), and whoever queued the operation knows what it means.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Then {
-    /// Nothing (the host was already answered).
-    Nothing,
-    /// Answer get servo data (0x53) with the value read.
-    ReplyServoData {
-        /// Where the request came from.
-        link: Link,
-        /// True for the 2-byte form.
-        two_bytes: bool,
-    },
-    /// Hand the parameter block read to the backup (0xEA).
-    Backup,
-}
+pub struct Ticket(pub u8);
 
 /// A servo operation waiting for the bus.
 #[derive(Clone, Debug)]
 struct Job {
     op: Op,
-    then: Then,
+    ticket: Option<Ticket>,
     attempt: u8,
 }
 
-/// What a finished servo operation hands on.
+/// A queued servo operation with a ticket that is done (answered, or out of retries).
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Completion {
-    /// A reply that waited for the operation, and the link it goes to.
-    Reply {
-        /// Where the request came from.
-        link: Link,
-        /// The reply.
-        reply: Frame,
-    },
-    /// Servo `index`'s parameter block for a backup; `None` if it could not be read.
-    Params {
-        /// Servo index (0..6 joints, 6 gripper).
-        index: usize,
-        /// The block, registers [`crate::backup::BLOCK_ADDR`] on.
-        block: Option<crate::backup::Block>,
-    },
+pub struct Finished {
+    /// The ticket it was queued with.
+    pub ticket: Ticket,
+    /// The bus id of the servo it addressed.
+    pub id: u8,
+    /// The servo's answer; `None` if it did not answer.
+    pub answer: Option<Packet>,
+}
+
+/// What the Atom knows about one servo and what it told it.
+#[derive(Clone, Copy, Debug, Default)]
+struct Servo {
+    /// Its state as last read.
+    health: ServoHealth,
+    /// Whether the Atom has told it anything (torque, a goal) since it started.
+    commanded: bool,
+    /// When its state was last read.
+    read_us: u64,
+    /// The goal it was last sent (checked), what its read-back is compared with.
+    last_goal: Option<Goal>,
+    /// Corrective writes sent to it since its last command.
+    repairs: u8,
+    /// When it last got a goal (it may not report moving until its next state read).
+    goal_sent_us: u64,
 }
 
 /// The servos' state and the Atom's instructions to them. See the [module doc](self).
@@ -98,53 +91,35 @@ pub enum Completion {
 pub struct ServoBank {
     /// True while the arm is powered on (torque enabled by 0x10, until 0x11).
     powered: bool,
-    /// Whether the Atom has told each servo anything (torque, a goal) since it started.
-    commanded: [bool; SERVOS],
-    health: [ServoHealth; SERVOS],
-    /// When each servo's state was last read.
-    read_us: [u64; SERVOS],
-    /// The goal each servo was last sent (checked), what its read-back is compared with.
-    last_goal: [Option<Goal>; SERVOS],
-    /// Corrective writes sent to each servo since its last command.
-    repairs: [u8; SERVOS],
-    /// When each servo last got a goal (it may not report moving until its next state read).
-    goal_sent_us: [u64; SERVOS],
+    /// One record per servo (0..6 joints, 6 gripper).
+    servos: [Servo; SERVOS],
     /// Checked goals not written yet.
     pending: Option<SafeGoals>,
     jobs: Deque<Job, OP_QUEUE>,
     refresh_next: usize,
     refresh_rounds: u32,
-    now_us: u64,
 }
 
 impl ServoBank {
     /// A bank for the servos of `settings`, nothing read yet.
     pub fn new(settings: &Settings) -> Self {
         let powered = settings.config().powered_at_boot;
-        let mut health = [ServoHealth::default(); SERVOS];
-        for h in &mut health {
-            h.position = Steps(STEPS_ZERO as i16);
-            h.torque_on = powered;
-        }
+        let servo = Servo {
+            health: ServoHealth {
+                position: Steps(STEPS_ZERO as i16),
+                torque_on: powered,
+                ..ServoHealth::default()
+            },
+            ..Servo::default()
+        };
         Self {
             powered,
-            commanded: [false; SERVOS],
-            health,
-            read_us: [0; SERVOS],
-            last_goal: [None; SERVOS],
-            repairs: [0; SERVOS],
-            goal_sent_us: [0; SERVOS],
+            servos: [servo; SERVOS],
             pending: None,
             jobs: Deque::new(),
             refresh_next: 0,
             refresh_rounds: 0,
-            now_us: 0,
         }
-    }
-
-    /// Sets the time of the current poll.
-    pub fn set_time(&mut self, now_us: u64) {
-        self.now_us = now_us;
     }
 
     /// True while the arm is powered on.
@@ -162,52 +137,71 @@ impl ServoBank {
         (0..SERVOS).all(|i| self.set_torque(settings, i, on))
     }
 
+    /// Switches torque back on for every servo released since the arm was powered on (power
+    /// on, 0x10, while already on). False if an operation did not fit.
+    pub fn focus_released(&mut self, settings: &Settings) -> bool {
+        let mut ok = true;
+        for i in 0..SERVOS {
+            if !self.enabled(i) {
+                ok &= self.set_torque(settings, i, true);
+            }
+        }
+        ok
+    }
+
     /// What the Atom knows about servo `index` (0..6 = joints 1..6, 6 = gripper).
     pub fn health(&self, index: usize) -> Option<&ServoHealth> {
-        self.health.get(index)
+        self.servos.get(index).map(|s| &s.health)
+    }
+
+    /// `f` of each joint's health (the default for a joint the bank does not have).
+    pub fn per_joint<T: Default>(&self, f: impl Fn(&ServoHealth) -> T) -> [T; JOINTS] {
+        core::array::from_fn(|j| self.health(j).map(&f).unwrap_or_default())
     }
 
     /// Present encoder positions of the joints.
     pub fn present_steps(&self) -> [Steps; JOINTS] {
-        core::array::from_fn(|j| self.health.get(j).map(|h| h.position).unwrap_or_default())
+        self.per_joint(|h| h.position)
     }
 
-    /// Present joint angles: each joint's last read position moved on by its last read speed
-    /// for the time since ([`Self::estimated_millisteps`]). At rest that is exactly the
-    /// servo's reading; while moving it is where the joint is now rather than where it was at
-    /// its read (the seven reads of a round are up to 4 ms apart, which would skew a pose read
-    /// during a fast move).
-    pub fn present_angles(&self, settings: &Settings) -> [Centideg; JOINTS] {
+    /// Present joint angles at `now_us`: each joint's last read position moved on by its last
+    /// read speed for the time since ([`Self::estimated_millisteps`]). At rest that is exactly
+    /// the servo's reading; while moving it is where the joint is now rather than where it was
+    /// at its read (the seven reads of a round are up to 4 ms apart, which would skew a pose
+    /// read during a fast move).
+    pub fn present_angles(&self, now_us: u64, settings: &Settings) -> [Centideg; JOINTS] {
         core::array::from_fn(|j| {
             settings
                 .config()
-                .millisteps_to_angle(j, self.estimated_millisteps(j))
+                .millisteps_to_angle(j, self.estimated_millisteps(now_us, j))
         })
     }
 
     /// Joint `j`'s last read speed, steps per second (0 if it does not answer or holds no
     /// torque).
     pub fn velocity(&self, j: usize) -> i32 {
-        self.health
-            .get(j)
+        self.health(j)
             .filter(|h| h.answering && h.torque_on)
             .map_or(0, |h| i32::from(h.speed_steps_per_s))
     }
 
-    /// Where joint `j` is now, in thousandths of a step: its last read position moved on by
-    /// its last read speed for the time since (the reads of a round are a few ms apart).
-    pub fn estimated_millisteps(&self, j: usize) -> i64 {
-        self.extrapolated_millisteps(j, self.velocity(j), 20_000)
+    /// Where joint `j` is at `now_us`, in thousandths of a step: its last read position moved
+    /// on by its last read speed for the time since (the reads of a round are a few ms apart).
+    pub fn estimated_millisteps(&self, now_us: u64, j: usize) -> i64 {
+        self.extrapolated_millisteps(now_us, j, self.velocity(j), 20_000)
     }
 
     /// Servo `index`'s last read position moved on at `speed` steps/s for the time since that
     /// read, at most `max_age_us`, in thousandths of a step.
-    fn extrapolated_millisteps(&self, index: usize, speed: i32, max_age_us: u64) -> i64 {
-        let position = self
-            .health
-            .get(index)
-            .map_or(0, |h| i64::from(h.position.0));
-        let age_us = self.read_age_us(index).min(max_age_us) as i64;
+    fn extrapolated_millisteps(
+        &self,
+        now_us: u64,
+        index: usize,
+        speed: i32,
+        max_age_us: u64,
+    ) -> i64 {
+        let position = self.health(index).map_or(0, |h| i64::from(h.position.0));
+        let age_us = self.read_age_us(now_us, index).min(max_age_us) as i64;
         position * 1000 + i64::from(speed) * age_us / 1000
     }
 
@@ -216,42 +210,42 @@ impl ServoBank {
     /// whose answers are lost still hears the goals (a SYNC WRITE has no answer), and it goes
     /// on towards its last goal until it gets another one.
     pub fn holds_torque(&self, index: usize) -> bool {
-        self.health
-            .get(index)
+        self.health(index)
             .is_some_and(|h| h.ever_answered && h.torque_on)
     }
 
-    /// Servo `index`'s speed as a stop must assume it, steps per second: its last read speed
-    /// while it answers ([`Self::velocity`]), and also while its reads are being lost, as long as
-    /// its last read is at most [`STALE_STATE_US`] old and it holds torque (it goes on doing
-    /// what it did); 0 otherwise.
-    pub fn last_known_velocity(&self, index: usize) -> i32 {
-        let Some(h) = self.health.get(index) else {
+    /// Servo `index`'s speed at `now_us` as a stop must assume it, steps per second: its last
+    /// read speed while it answers ([`Self::velocity`]), and also while its reads are being
+    /// lost, as long as its last read is at most [`STALE_STATE_US`] old and it holds torque (it
+    /// goes on doing what it did); 0 otherwise.
+    pub fn last_known_velocity(&self, now_us: u64, index: usize) -> i32 {
+        let Some(h) = self.health(index) else {
             return 0;
         };
         if h.answering {
             return self.velocity(index);
         }
-        if !self.holds_torque(index) || self.read_age_us(index) > STALE_STATE_US {
+        if !self.holds_torque(index) || self.read_age_us(now_us, index) > STALE_STATE_US {
             return 0;
         }
         i32::from(h.speed_steps_per_s)
     }
 
-    /// Where servo `index` is now as a stop must assume it, in thousandths of a step: the
-    /// estimate of [`Self::estimated_millisteps`] while it answers; while its reads are being
-    /// lost, its last read position moved on by [`Self::last_known_velocity`] for the whole time
-    /// since (up to [`STALE_STATE_US`]), but never past its last goal (a servo stops there).
-    pub fn last_known_millisteps(&self, index: usize) -> i64 {
-        let Some(h) = self.health.get(index) else {
+    /// Where servo `index` is at `now_us` as a stop must assume it, in thousandths of a step:
+    /// the estimate of [`Self::estimated_millisteps`] while it answers; while its reads are
+    /// being lost, its last read position moved on by [`Self::last_known_velocity`] for the
+    /// whole time since (up to [`STALE_STATE_US`]), but never past its last goal (a servo stops
+    /// there).
+    pub fn last_known_millisteps(&self, now_us: u64, index: usize) -> i64 {
+        let Some(h) = self.health(index) else {
             return 0;
         };
         if h.answering {
-            return self.estimated_millisteps(index);
+            return self.estimated_millisteps(now_us, index);
         }
         let read = i64::from(h.position.0) * 1000;
-        let moved =
-            self.extrapolated_millisteps(index, self.last_known_velocity(index), STALE_STATE_US);
+        let speed = self.last_known_velocity(now_us, index);
+        let moved = self.extrapolated_millisteps(now_us, index, speed, STALE_STATE_US);
         match self.last_goal(index) {
             Some(goal) => {
                 let goal = i64::from(goal.position.0) * 1000;
@@ -261,94 +255,84 @@ impl ServoBank {
         }
     }
 
-    /// Time since servo `index`'s state was last read, microseconds.
-    fn read_age_us(&self, index: usize) -> u64 {
-        self.now_us
-            .saturating_sub(self.read_us.get(index).copied().unwrap_or(0))
+    /// Time from servo `index`'s last state read to `now_us`, microseconds.
+    fn read_age_us(&self, now_us: u64, index: usize) -> u64 {
+        now_us.saturating_sub(self.servos.get(index).map_or(0, |s| s.read_us))
     }
 
-    /// True while a joint that answers reports moving, or one whose latest reads were lost
-    /// reported moving at its last read (up to [`STALE_STATE_US`] ago, holding torque): it is
-    /// most likely still moving, and "is moving" must not say no while it brakes.
-    pub fn joints_moving(&self) -> bool {
-        self.health.iter().take(JOINTS).enumerate().any(|(j, h)| {
+    /// True at `now_us` while a joint that answers reports moving, or one whose latest reads
+    /// were lost reported moving at its last read (up to [`STALE_STATE_US`] ago, holding
+    /// torque): it is most likely still moving, and "is moving" must not say no while it
+    /// brakes.
+    pub fn joints_moving(&self, now_us: u64) -> bool {
+        self.servos.iter().take(JOINTS).enumerate().any(|(j, s)| {
+            let h = &s.health;
             h.moving
-                && (h.answering || (self.holds_torque(j) && self.read_age_us(j) <= STALE_STATE_US))
+                && (h.answering
+                    || (self.holds_torque(j) && self.read_age_us(now_us, j) <= STALE_STATE_US))
         })
     }
 
-    /// True while servo `index` moves: its moving flag, or a goal sent moments ago that its
-    /// state read has not confirmed yet (so "is moving" right after a command says yes).
-    pub fn servo_moving(&self, index: usize) -> bool {
-        let Some(h) = self.health.get(index) else {
+    /// True at `now_us` while servo `index` moves: its moving flag, or a goal sent moments ago
+    /// that its state read has not confirmed yet (so "is moving" right after a command says
+    /// yes).
+    pub fn servo_moving(&self, now_us: u64, index: usize) -> bool {
+        let Some(s) = self.servos.get(index) else {
             return false;
         };
-        let recent = self
-            .goal_sent_us
-            .get(index)
-            .is_some_and(|&t| self.now_us.saturating_sub(t) < GOAL_CONFIRM_US);
-        let far = self
+        let recent = now_us.saturating_sub(s.goal_sent_us) < GOAL_CONFIRM_US;
+        let far = s
             .last_goal
-            .get(index)
-            .copied()
-            .flatten()
-            .is_some_and(|g| {
-                (i32::from(g.position.0) - i32::from(h.position.0)).abs() > IN_POSITION_STEPS
-            });
-        h.answering && (h.moving || (recent && far))
+            .is_some_and(|g| !tolerance::servo_at(g.position, s.health.position));
+        s.health.answering && (s.health.moving || (recent && far))
     }
 
     /// True if servo `index` answers and holds torque (0x50).
     pub fn enabled(&self, index: usize) -> bool {
-        self.health
-            .get(index)
+        self.health(index)
             .is_some_and(|h| h.answering && h.torque_on)
     }
 
     /// The goal servo `index` was last sent, if it holds one.
     pub fn last_goal(&self, index: usize) -> Option<Goal> {
-        self.last_goal.get(index).copied().flatten()
+        self.servos.get(index).and_then(|s| s.last_goal)
     }
 
     /// Checks `goals` (the safety check) and, if they pass, makes them the next goals written
-    /// to the servos (merged with goals not written yet). Switches torque on for a released
-    /// servo that gets a goal.
-    pub fn send_goals(&mut self, settings: &Settings, goals: GoalSet) -> Result<(), AtomError> {
+    /// to the servos (merged with goals not written yet), sent at `now_us`. Switches torque on
+    /// for a released servo that gets a goal.
+    pub fn send_goals(
+        &mut self,
+        now_us: u64,
+        settings: &Settings,
+        goals: Goals,
+    ) -> Result<(), AtomError> {
         let safe = safety::check(settings.config(), settings.limits(), self.powered, goals)?;
-        let mut merged: GoalSet = self
-            .pending
-            .take()
-            .map(|p| *p.goals())
-            .unwrap_or([None; SERVOS]);
-        for (i, (slot, new)) in merged.iter_mut().zip(safe.goals()).enumerate() {
-            if let Some(g) = new {
-                // A released servo is switched on first (holding where it is, until the goal
-                // is written): the goal below then replaces that hold as what it was told.
-                if self.health.get(i).is_some_and(|h| !h.torque_on) {
-                    self.set_torque(settings, i, true);
-                }
-                *slot = Some(*g);
-                if let Some(c) = self.commanded.get_mut(i) {
-                    *c = true;
-                }
-                if let Some(last) = self.last_goal.get_mut(i) {
-                    *last = Some(*g);
-                }
-                if let Some(r) = self.repairs.get_mut(i) {
-                    *r = 0;
-                }
-                if let Some(t) = self.goal_sent_us.get_mut(i) {
-                    *t = self.now_us;
-                }
+        let waiting = self.pending.take().map_or(Goals::NONE, |p| *p.goals());
+        for (i, goal) in safe.goals().iter() {
+            // A released servo is switched on first (holding where it is, until the goal
+            // is written): the goal below then replaces that hold as what it was told.
+            if self.health(i).is_some_and(|h| !h.torque_on) {
+                self.set_torque(settings, i, true);
+            }
+            if let Some(s) = self.servos.get_mut(i) {
+                s.commanded = true;
+                s.last_goal = Some(goal);
+                s.repairs = 0;
+                s.goal_sent_us = now_us;
             }
         }
-        // Re-checking the merge cannot fail (each goal passed on its own), but keeps the
-        // invariant local: only checked goals are ever pending.
+        self.hold_pending(settings, waiting.merge(safe.goals()))
+    }
+
+    /// Makes `goals` the goals not written yet, through the safety check again: the limits
+    /// may have changed since a goal was made, and only checked goals are ever pending.
+    fn hold_pending(&mut self, settings: &Settings, goals: Goals) -> Result<(), AtomError> {
         self.pending = Some(safety::check(
             settings.config(),
             settings.limits(),
             self.powered,
-            merged,
+            goals,
         )?);
         Ok(())
     }
@@ -363,23 +347,20 @@ impl ServoBank {
         }
         let queued = if on {
             match self.torque_on_op(settings, index, id) {
-                Some(op) => self.queue_op(op, Then::Nothing),
+                Some(op) => self.queue_op(op),
                 // Position not read yet: the read-back switches it on after the first read.
                 None => true,
             }
         } else {
             // A limp servo holds no goal: nothing to compare its read-back against.
             self.forget_goal(index);
-            Op::write(id, reg::TORQUE_ENABLE, &[0])
-                .is_some_and(|op| self.queue_op(op, Then::Nothing))
+            Op::write(id, reg::TORQUE_ENABLE, &[0]).is_some_and(|op| self.queue_op(op))
         };
-        if let Some(c) = self.commanded.get_mut(index) {
-            *c = true;
-        }
-        if queued && let Some(h) = self.health.get_mut(index) {
-            h.torque_on = on;
-            if let Some(r) = self.repairs.get_mut(index) {
-                *r = 0;
+        if let Some(s) = self.servos.get_mut(index) {
+            s.commanded = true;
+            if queued {
+                s.health.torque_on = on;
+                s.repairs = 0;
             }
         }
         queued
@@ -390,7 +371,7 @@ impl ServoBank {
     /// `None` until the servo's position has been read. The hold goal becomes the servo's
     /// last goal (what the read-back compares against).
     fn torque_on_op(&mut self, settings: &Settings, index: usize, id: u8) -> Option<Op> {
-        let h = self.health.get(index)?;
+        let h = self.health(index)?;
         if !h.answering {
             return None;
         }
@@ -403,18 +384,16 @@ impl ServoBank {
             None => h.position,
         };
         let config = settings.config();
-        let mut one: GoalSet = [None; SERVOS];
-        if let Some(slot) = one.get_mut(index) {
-            *slot = Some(Goal {
-                position,
-                speed_steps_per_s: config.joint_speed_steps(HOLD_SPEED_PERCENT) as u16,
-                accel: config.joint_accel_register(),
-            });
-        }
+        let hold = Goal {
+            position,
+            speed_steps_per_s: config.joint_speed_steps(HOLD_SPEED_PERCENT) as u16,
+            accel: config.joint_accel_register(),
+        };
+        let one = Goals::one(index, hold);
         let safe = safety::check(config, settings.limits(), self.powered, one).ok()?;
         let op = safe.torque_on_write(index, id)?;
-        if let Some(last) = self.last_goal.get_mut(index) {
-            *last = safe.goals().get(index).copied().flatten();
+        if let Some(s) = self.servos.get_mut(index) {
+            s.last_goal = safe.goals().get(index);
         }
         Some(op)
     }
@@ -422,8 +401,8 @@ impl ServoBank {
     /// Records that servo `index` was calibrated (torque 128): its present position is now
     /// 2048 and it holds no goal until told again.
     pub fn calibrated(&mut self, index: usize) {
-        if let Some(h) = self.health.get_mut(index) {
-            h.position = Steps(STEPS_ZERO as i16);
+        if let Some(s) = self.servos.get_mut(index) {
+            s.health.position = Steps(STEPS_ZERO as i16);
         }
         self.forget_goal(index);
     }
@@ -431,18 +410,28 @@ impl ServoBank {
     /// Forgets servo `index`'s goal, sent or not yet written: after a calibration or a
     /// release it would mean another place (or move a limp servo when it is switched on).
     fn forget_goal(&mut self, index: usize) {
-        if let Some(g) = self.last_goal.get_mut(index) {
-            *g = None;
+        if let Some(s) = self.servos.get_mut(index) {
+            s.last_goal = None;
         }
         self.pending = self.pending.take().map(|p| p.without(index));
     }
 
-    /// Queues a servo operation. `false` if the queue is full.
-    pub fn queue_op(&mut self, op: Op, then: Then) -> bool {
+    /// Queues a servo operation whose result nobody waits for. `false` if the queue is full.
+    pub fn queue_op(&mut self, op: Op) -> bool {
+        self.push_job(op, None)
+    }
+
+    /// Queues a servo operation whose result goes back with `ticket` ([`Self::finish`]).
+    /// `false` if the queue is full.
+    pub fn queue_read(&mut self, op: Op, ticket: Ticket) -> bool {
+        self.push_job(op, Some(ticket))
+    }
+
+    fn push_job(&mut self, op: Op, ticket: Option<Ticket>) -> bool {
         self.jobs
             .push_back(Job {
                 op,
-                then,
+                ticket,
                 attempt: 0,
             })
             .is_ok()
@@ -478,8 +467,7 @@ impl ServoBank {
                 self.refresh_rounds = self.refresh_rounds.wrapping_add(1);
             }
             let lost = self
-                .health
-                .get(index)
+                .health(index)
                 .is_some_and(|h| !h.answering && h.misses >= config.timing.misses_before_lost);
             if lost && !self.refresh_rounds.is_multiple_of(LOST_SERVO_PROBE_ROUNDS) {
                 continue;
@@ -499,15 +487,17 @@ impl ServoBank {
         self.refresh_rounds
     }
 
-    /// Applies the result of a finished transaction; `corrupt` says the receiver saw a bad
-    /// checksum during it. Returns the reply a host request was waiting for, if any.
+    /// Applies the result of a transaction that finished at `now_us`; `corrupt` says the
+    /// receiver saw a bad checksum during it. A timed-out operation with retries left stays
+    /// queued; one with a ticket that is done is handed back ([`Finished`]).
     pub fn finish(
         &mut self,
+        now_us: u64,
         settings: &Settings,
         op: Op,
         outcome: Outcome,
         corrupt: bool,
-    ) -> Option<Completion> {
+    ) -> Option<Finished> {
         let config = settings.config();
         let index = config.servo_ids.iter().position(|&id| id == op.id());
         let is_state_read = matches!(
@@ -521,20 +511,19 @@ impl ServoBank {
         let job_matches = self.jobs.front().is_some_and(|j| j.op == op);
         if is_state_read && !job_matches {
             let i = index?;
-            let h = self.health.get_mut(i)?;
+            let s = self.servos.get_mut(i)?;
             match &outcome {
                 Outcome::Answered(p) => {
-                    let first = !h.ever_answered;
-                    apply_state(h, p);
-                    if let Some(t) = self.read_us.get_mut(i) {
-                        *t = self.now_us;
-                    }
+                    let first = !s.health.ever_answered;
+                    apply_state(&mut s.health, p);
+                    s.read_us = now_us;
                     if first {
                         self.adopt(i, p);
                     }
                     self.verify(settings, i);
                 }
                 _ => {
+                    let h = &mut s.health;
                     h.comm_errors = h.comm_errors.wrapping_add(1);
                     h.corrupt_answers = corrupt;
                     h.misses = h.misses.saturating_add(1);
@@ -548,10 +537,9 @@ impl ServoBank {
         if !job_matches {
             return None;
         }
-        if let (Some(h), Outcome::Answered(p)) =
-            (index.and_then(|i| self.health.get_mut(i)), &outcome)
-        {
-            h.fault_bits = p.code();
+        let servo = index.and_then(|i| self.servos.get_mut(i));
+        if let (Some(s), Outcome::Answered(p)) = (servo, &outcome) {
+            s.health.fault_bits = p.code();
         }
         if outcome == Outcome::TimedOut {
             if let Some(job) = self.jobs.front_mut()
@@ -560,52 +548,33 @@ impl ServoBank {
                 job.attempt += 1;
                 return None;
             }
-            if let Some(h) = index.and_then(|i| self.health.get_mut(i)) {
-                h.comm_errors = h.comm_errors.wrapping_add(1);
+            if let Some(s) = index.and_then(|i| self.servos.get_mut(i)) {
+                s.health.comm_errors = s.health.comm_errors.wrapping_add(1);
             }
         }
         let job = self.jobs.pop_front()?;
-        if job.then == Then::Backup {
-            let block = match &outcome {
-                Outcome::Answered(p) => p.params().try_into().ok(),
+        Some(Finished {
+            ticket: job.ticket?,
+            id: op.id(),
+            answer: match outcome {
+                Outcome::Answered(p) => Some(p),
                 _ => None,
-            };
-            return Some(Completion::Params {
-                index: index?,
-                block,
-            });
-        }
-        let Then::ReplyServoData { link, two_bytes } = job.then else {
-            return None;
-        };
-        let value: i16 = match &outcome {
-            Outcome::Answered(p) if two_bytes => p.u16_at(0).map_or(-1, |v| v as i16),
-            Outcome::Answered(p) => p.params().first().map_or(-1, |&v| i16::from(v)),
-            _ => -1,
-        };
-        let reply = if two_bytes {
-            Frame::new(cmd::GET_SERVO_DATA, &value.to_be_bytes())
-        } else {
-            Frame::new(cmd::GET_SERVO_DATA, &[value as u8])
-        }?;
-        Some(Completion::Reply { link, reply })
+            },
+        })
     }
 
     /// Takes over what servo `index` is doing when the Atom hears it for the first time and
     /// has not told it anything yet: a servo that holds torque keeps its goal (the Atom
     /// restarted while the arm was on: the arm stays powered, a move in progress finishes,
     /// nothing goes limp or stops), a released one stays released.
-    fn adopt(&mut self, index: usize, packet: &protocol_core::servo::Packet) {
-        if self.commanded.get(index).copied().unwrap_or(true) {
-            return;
-        }
-        let Some(h) = self.health.get_mut(index) else {
+    fn adopt(&mut self, index: usize, packet: &Packet) {
+        let Some(s) = self.servos.get_mut(index) else {
             return;
         };
-        if !h.torque_reported {
+        if s.commanded || !s.health.torque_reported {
             return;
         }
-        h.torque_on = true;
+        s.health.torque_on = true;
         self.powered = true;
         let at = |addr: u8| usize::from(addr - STATE_READ_ADDR);
         let speed = packet.u16_at(at(reg::GOAL_SPEED)).unwrap_or(0) & 0x7FFF;
@@ -614,20 +583,290 @@ impl ServoBank {
             .get(at(reg::ACCELERATION))
             .copied()
             .unwrap_or(0);
-        if let Some(goal) = self.last_goal.get_mut(index) {
-            *goal = Some(Goal {
-                position: h.goal_reported,
-                speed_steps_per_s: speed.max(1),
-                accel: accel.max(1),
-            });
-        }
+        s.last_goal = Some(Goal {
+            position: s.health.goal_reported,
+            speed_steps_per_s: speed.max(1),
+            accel: accel.max(1),
+        });
     }
 
     /// The gripper's present position.
     pub fn gripper_position(&self) -> Steps {
-        self.health
-            .get(GRIPPER)
-            .map(|h| h.position)
-            .unwrap_or_default()
+        self.health(GRIPPER).map(|h| h.position).unwrap_or_default()
+    }
+}
+
+/// Servo state reads and banks that have read them, for the unit tests of the parts that act
+/// on the servos.
+#[cfg(test)]
+pub(crate) mod test_support {
+    use protocol_core::servo::{Packet, reg, to_sign_magnitude};
+
+    use super::{STATE_READ_ADDR, STATE_READ_LEN, ServoBank};
+    use crate::config::{AtomConfig, JOINTS, SERVOS};
+    use crate::driver::{Op, Outcome};
+    use crate::settings::Settings;
+
+    /// The settings of a powered arm with the default configuration.
+    pub fn powered() -> Settings {
+        Settings::new(AtomConfig {
+            powered_at_boot: true,
+            ..AtomConfig::default()
+        })
+    }
+
+    /// The state read (registers 40..=70) of servo `id` holding torque at `position`, moving at
+    /// `speed` steps/s, its goal register at `goal`.
+    pub fn state(id: u8, position: i16, speed: i16, goal: i16) -> Packet {
+        let mut regs = [0u8; STATE_READ_LEN as usize];
+        let mut put = |addr: u8, bytes: &[u8]| {
+            let at = usize::from(addr - STATE_READ_ADDR);
+            regs[at..at + bytes.len()].copy_from_slice(bytes);
+        };
+        put(reg::TORQUE_ENABLE, &[1]);
+        put(reg::ACCELERATION, &[50]);
+        put(
+            reg::GOAL_POSITION,
+            &to_sign_magnitude(goal, 15).to_le_bytes(),
+        );
+        put(reg::GOAL_SPEED, &1000u16.to_le_bytes());
+        put(
+            reg::PRESENT_POSITION,
+            &to_sign_magnitude(position, 15).to_le_bytes(),
+        );
+        put(
+            reg::PRESENT_SPEED,
+            &to_sign_magnitude(speed, 15).to_le_bytes(),
+        );
+        put(reg::MOVING, &[u8::from(speed != 0)]);
+        Packet::new(id, 0, &regs).expect("a state read fits a packet")
+    }
+
+    /// Reads servo `index` at `now_us` as [`state`] says.
+    pub fn read(
+        bank: &mut ServoBank,
+        settings: &Settings,
+        now_us: u64,
+        index: usize,
+        state: Packet,
+    ) {
+        let id = settings.config().servo_ids[index];
+        let op = Op::Read {
+            id,
+            addr: STATE_READ_ADDR,
+            count: STATE_READ_LEN,
+        };
+        assert_eq!(
+            bank.finish(now_us, settings, op, Outcome::Answered(state), false),
+            None
+        );
+    }
+
+    /// A bank that read every servo at `now_us`: joint `j` at `positions[j]` moving at
+    /// `speeds[j]` steps/s toward a goal far ahead (at rest: its goal is where it is), the
+    /// gripper at 2048.
+    pub fn bank_read(
+        settings: &Settings,
+        now_us: u64,
+        positions: [i16; JOINTS],
+        speeds: [i16; JOINTS],
+    ) -> ServoBank {
+        let mut bank = ServoBank::new(settings);
+        for i in 0..SERVOS {
+            let (position, speed) = if i < JOINTS {
+                (positions[i], speeds[i])
+            } else {
+                (2048, 0)
+            };
+            let goal = position.saturating_add(speed.signum() * 1000);
+            let id = settings.config().servo_ids[i];
+            read(
+                &mut bank,
+                settings,
+                now_us,
+                i,
+                state(id, position, speed, goal),
+            );
+        }
+        bank
+    }
+
+    /// A powered arm ([`powered`]) whose bank read every servo at rest at 2048 (every joint
+    /// at 0 deg) at time 0.
+    pub fn at_rest() -> (Settings, ServoBank) {
+        let settings = powered();
+        let bank = bank_read(&settings, 0, [2048; JOINTS], [0; JOINTS]);
+        (settings, bank)
+    }
+
+    /// Every operation queued in `bank`, in order, each finished as sent.
+    pub fn queued(bank: &mut ServoBank, settings: &Settings) -> std::vec::Vec<Op> {
+        let mut ops = std::vec::Vec::new();
+        while let Some(op) = bank.due_job() {
+            ops.push(op.clone());
+            bank.finish(0, settings, op, Outcome::Sent, false);
+        }
+        ops
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use protocol_core::servo::Packet;
+
+    use super::test_support::{at_rest, bank_read, powered, read, state};
+    use super::*;
+    use crate::driver::Op;
+
+    fn goal(position: i16) -> Goal {
+        Goal {
+            position: Steps(position),
+            speed_steps_per_s: 500,
+            accel: 20,
+        }
+    }
+
+    #[test]
+    fn goals_sent_before_the_write_merge_into_one_sync_write() {
+        let (settings, mut bank) = at_rest();
+        bank.send_goals(10, &settings, Goals::one(0, goal(2100)))
+            .unwrap();
+        bank.send_goals(20, &settings, Goals::one(1, goal(2200)))
+            .unwrap();
+        bank.send_goals(30, &settings, Goals::one(0, goal(2150)))
+            .unwrap();
+        let Some(Op::Broadcast(write)) = bank.take_goal_write(&settings) else {
+            panic!("one SYNC WRITE");
+        };
+        // Two servos' move blocks (id + 7 bytes each) after the address and length.
+        assert_eq!(write.params().len(), 2 + 2 * 8);
+        assert_eq!(bank.take_goal_write(&settings), None, "taken");
+        assert_eq!(
+            bank.last_goal(0),
+            Some(goal(2150)),
+            "the newer goal of joint 1"
+        );
+        assert_eq!(bank.last_goal(1), Some(goal(2200)));
+    }
+
+    #[test]
+    fn a_goal_outside_the_limits_or_powered_off_is_never_pending() {
+        let (settings, mut bank) = at_rest();
+        // Joint 2's limit is 140 deg: about 3641 steps.
+        assert_eq!(
+            bank.send_goals(0, &settings, Goals::one(1, goal(4000))),
+            Err(AtomError::JointLimit(1))
+        );
+        assert!(bank.power(&settings, false));
+        assert_eq!(
+            bank.send_goals(0, &settings, Goals::one(0, goal(2100))),
+            Err(AtomError::PoweredOff)
+        );
+        assert_eq!(bank.take_goal_write(&settings), None);
+    }
+
+    #[test]
+    fn a_goal_lost_on_the_wire_is_repaired_at_most_three_times() {
+        let (settings, mut bank) = at_rest();
+        bank.send_goals(0, &settings, Goals::one(0, goal(2300)))
+            .unwrap();
+        assert!(bank.take_goal_write(&settings).is_some());
+        for repair in 0..readback::MAX_REPAIRS {
+            // The servo reports its old goal: the SYNC WRITE did not arrive.
+            read(&mut bank, &settings, 1_000, 0, state(1, 2048, 0, 2048));
+            assert!(
+                bank.take_goal_write(&settings).is_some(),
+                "repair {repair} re-sends the goal"
+            );
+        }
+        read(&mut bank, &settings, 1_000, 0, state(1, 2048, 0, 2048));
+        assert_eq!(bank.take_goal_write(&settings), None, "given up");
+        // A goal that arrived needs no repair.
+        bank.send_goals(0, &settings, Goals::one(0, goal(2400)))
+            .unwrap();
+        assert!(bank.take_goal_write(&settings).is_some());
+        read(&mut bank, &settings, 2_000, 0, state(1, 2048, 100, 2400));
+        assert_eq!(bank.take_goal_write(&settings), None);
+    }
+
+    #[test]
+    fn a_lost_torque_write_is_repaired() {
+        let (settings, mut bank) = at_rest();
+        assert!(bank.set_torque(&settings, 2, false));
+        assert!(bank.due_job().is_some(), "the torque write is queued");
+        let job = bank.due_job().unwrap();
+        assert_eq!(bank.finish(0, &settings, job, Outcome::Sent, false), None);
+        // The servo still reports torque on: the write got lost.
+        read(&mut bank, &settings, 1_000, 2, state(3, 2048, 0, 2048));
+        assert_eq!(
+            bank.due_job(),
+            Op::write(3, reg::TORQUE_ENABLE, &[0]),
+            "written again"
+        );
+    }
+
+    #[test]
+    fn a_read_with_a_ticket_comes_back_once_done_and_a_timeout_is_retried() {
+        let (settings, mut bank) = at_rest();
+        let op = Op::Read {
+            id: 4,
+            addr: 21,
+            count: 3,
+        };
+        assert!(bank.queue_read(op.clone(), Ticket(5)));
+        for _ in 0..settings.config().timing.retries {
+            assert_eq!(
+                bank.finish(0, &settings, op.clone(), Outcome::TimedOut, false),
+                None
+            );
+            assert_eq!(bank.due_job(), Some(op.clone()), "tried again");
+        }
+        let answer = Packet::new(4, 0, &[1, 2, 3]).unwrap();
+        let done = bank.finish(0, &settings, op, Outcome::Answered(answer.clone()), false);
+        assert_eq!(
+            done,
+            Some(Finished {
+                ticket: Ticket(5),
+                id: 4,
+                answer: Some(answer),
+            })
+        );
+        assert_eq!(bank.due_job(), None);
+    }
+
+    #[test]
+    fn present_angles_move_on_with_the_read_speed_at_the_time_asked() {
+        let settings = powered();
+        let bank = bank_read(&settings, 0, [2048; JOINTS], [1000, 0, 0, 0, 0, 0]);
+        let at = |now_us| bank.present_angles(now_us, &settings)[0];
+        assert_eq!(at(0), settings.angle(0, Steps(2048)));
+        // 1000 steps/s for 10 ms: 10 steps further.
+        assert_eq!(at(10_000), settings.angle(0, Steps(2058)));
+        assert!(bank.joints_moving(0));
+        assert!(bank.servo_moving(0, 0));
+    }
+
+    #[test]
+    fn a_servo_that_misses_reads_is_lost_and_probed_only_now_and_then() {
+        let (settings, mut bank) = at_rest();
+        let misses = settings.config().timing.misses_before_lost;
+        for _ in 0..misses {
+            // One round: the gripper (index 6) times out every time.
+            for i in 0..SERVOS {
+                let op = bank.next_refresh_op(&settings).unwrap();
+                let outcome = if i == GRIPPER {
+                    Outcome::TimedOut
+                } else {
+                    Outcome::Answered(state(op.id(), 2048, 0, 2048))
+                };
+                bank.finish(0, &settings, op, outcome, false);
+            }
+        }
+        assert!(!bank.health(GRIPPER).unwrap().answering);
+        let ids: heapless::Vec<u8, 64> = (0..6 * 7)
+            .map(|_| bank.next_refresh_op(&settings).unwrap().id())
+            .collect();
+        let probes = ids.iter().filter(|&&id| id == 7).count();
+        assert!(probes <= 1, "{ids:?}");
     }
 }

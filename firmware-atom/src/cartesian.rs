@@ -1,28 +1,31 @@
 //! Coordinates: the kinematics model with the selected tool and world frames, and the
 //! conversions between the host protocol's 16-bit pose and the kinematics' 32-bit one.
 
-use kinematics_core::{IkError, JointAngles, Kinematics, Transform};
+use core::cell::Cell;
+
+use kinematics_core::{IkError, JointAngles, Kinematics};
 use protocol_core::command::{EndType, MoveMode, Pose, ReferenceFrame};
 use protocol_core::units::{Centideg, DeciMm};
 
 use crate::config::{JOINTS, JointLimit};
 
-/// The kinematics with the frames the host selected (0x81..0x8A).
+/// The kinematics with the frames the host selected (0x81..0x8A). The frames are private:
+/// every setter re-applies them to the model, so the model always matches what they say.
 #[derive(Clone, Debug)]
 pub struct Cartesian {
     kin: Kinematics,
     /// Tool pose in the flange frame (0x81).
-    pub tool: Pose,
+    tool: Pose,
     /// Base pose in the world frame (0x83).
-    pub world: Pose,
+    world: Pose,
     /// Reference frame of reported and commanded coordinates (0x85).
-    pub reference: ReferenceFrame,
+    reference: ReferenceFrame,
     /// End type: flange or tool tip (0x89).
-    pub end: EndType,
+    end: EndType,
     /// Default interpolation of send coords without a mode byte (0x87).
-    pub movement: MoveMode,
+    movement: MoveMode,
     /// FK of the last angles asked about, so repeated queries of an arm at rest cost nothing.
-    cache: Option<([Centideg; JOINTS], Pose)>,
+    cache: Cell<Option<([Centideg; JOINTS], Pose)>>,
 }
 
 impl Cartesian {
@@ -35,7 +38,7 @@ impl Cartesian {
             reference: ReferenceFrame::Base,
             end: EndType::Flange,
             movement: MoveMode::Joint,
-            cache: None,
+            cache: Cell::new(None),
         };
         c.set_limits(limits);
         c
@@ -53,24 +56,78 @@ impl Cartesian {
         self.kin.set_limits(l);
     }
 
-    /// Re-applies the tool/world selection after one of the frame settings changed.
-    pub fn apply_frames(&mut self) {
+    /// Tool pose in the flange frame (0x82).
+    pub fn tool(&self) -> Pose {
+        self.tool
+    }
+
+    /// Sets the tool pose (0x81).
+    pub fn set_tool(&mut self, pose: Pose) {
+        self.tool = pose;
+        self.apply_frames();
+    }
+
+    /// Base pose in the world frame (0x84).
+    pub fn world(&self) -> Pose {
+        self.world
+    }
+
+    /// Sets the base pose in the world frame (0x83).
+    pub fn set_world(&mut self, pose: Pose) {
+        self.world = pose;
+        self.apply_frames();
+    }
+
+    /// Reference frame of reported and commanded coordinates (0x86).
+    pub fn reference(&self) -> ReferenceFrame {
+        self.reference
+    }
+
+    /// Sets the reference frame (0x85).
+    pub fn set_reference(&mut self, frame: ReferenceFrame) {
+        self.reference = frame;
+        self.apply_frames();
+    }
+
+    /// End type: flange or tool tip (0x8A).
+    pub fn end(&self) -> EndType {
+        self.end
+    }
+
+    /// Sets the end type (0x89).
+    pub fn set_end(&mut self, end: EndType) {
+        self.end = end;
+        self.apply_frames();
+    }
+
+    /// Default interpolation of send coords without a mode byte (0x88).
+    pub fn movement(&self) -> MoveMode {
+        self.movement
+    }
+
+    /// Sets the default interpolation (0x87); the model does not depend on it.
+    pub fn set_movement(&mut self, mode: MoveMode) {
+        self.movement = mode;
+    }
+
+    /// Applies the tool/world selection to the model after one of the frame settings changed.
+    fn apply_frames(&mut self) {
         let tool = (self.end == EndType::Tool).then(|| to_kin(&self.tool));
         let world = (self.reference == ReferenceFrame::World).then(|| to_kin(&self.world));
         self.kin.set_tool(tool);
         self.kin.set_world(world);
-        self.cache = None;
+        self.cache.set(None);
     }
 
     /// The end pose at joint angles `angles`.
-    pub fn forward(&mut self, angles: &[Centideg; JOINTS]) -> Pose {
-        if let Some((a, p)) = &self.cache
-            && a == angles
+    pub fn forward(&self, angles: &[Centideg; JOINTS]) -> Pose {
+        if let Some((a, p)) = self.cache.get()
+            && a == *angles
         {
-            return *p;
+            return p;
         }
         let pose = from_kin(&self.kin.forward(&joints(angles)));
-        self.cache = Some((*angles, pose));
+        self.cache.set(Some((*angles, pose)));
         pose
     }
 
@@ -82,25 +139,6 @@ impl Cartesian {
     ) -> Result<[Centideg; JOINTS], IkError> {
         let q = self.kin.inverse(&to_kin(pose), &joints(seed))?;
         Ok(angles(&q))
-    }
-
-    /// The pose `pose` rotated by `delta` about base axis `axis` (0 x, 1 y, 2 z), position kept.
-    pub fn rotate_about_base(&self, pose: &Pose, axis: usize, delta: Centideg) -> Pose {
-        let d = i32::from(delta.0);
-        let rot = kinematics_core::Pose {
-            rx: if axis == 0 { d } else { 0 },
-            ry: if axis == 1 { d } else { 0 },
-            rz: if axis == 2 { d } else { 0 },
-            ..Default::default()
-        };
-        let turned = Transform::from_pose(&rot).then(&Transform::from_pose(&to_kin(pose)));
-        let r = from_kin(&turned.to_pose());
-        Pose {
-            x: pose.x,
-            y: pose.y,
-            z: pose.z,
-            ..r
-        }
     }
 
     /// The kinematics model (for linear paths).
@@ -177,7 +215,7 @@ mod tests {
 
     #[test]
     fn zero_pose_matches_the_vendor_model() {
-        let mut c = Cartesian::new(&DEFAULT_LIMITS);
+        let c = Cartesian::new(&DEFAULT_LIMITS);
         let p = c.forward(&[Centideg(0); JOINTS]);
         // docs/kinematics.md: flange at (45.6, -63.4, 412.67) mm, (-90, 0, -90) deg.
         assert!((i32::from(p.x.0) - 456).abs() <= 1, "{p:?}");

@@ -10,29 +10,27 @@
 
 use protocol_core::Frame;
 use protocol_core::command::{
-    DataWidth, Direction, EndType, MoveMode, PinMode as WirePinMode, Pose, PositionTarget, Reply,
+    DataWidth, Direction, EndType, MoveMode, PinMode as WirePinMode, PositionTarget, Reply,
     Request, ServoErrorCode, ServoSelect, cmd,
 };
-use protocol_core::units::{Centideg, Decideg, Steps};
+use protocol_core::units::{Centideg, Decideg};
 
-use crate::atom::Parts;
 use crate::cartesian::for_client;
-use crate::config::{GRIPPER, JOINTS, SERVOS};
+use crate::config::{GRIPPER, JOINTS, SERVOS, in_encoder_range};
+use crate::context::Context;
 use crate::error::AtomError;
 use crate::health::ServoHealth;
 use crate::io::{AtomIo, PinMode, is_output_pin, mode_allowed};
 use crate::link::Link;
-use crate::motion::{JogDirection, Target, Way, angles_match};
-use crate::registers::{self, ServoAccess};
+use crate::motion::{Command, JogDirection, Target};
+use crate::parts::Parts;
+use crate::waiting::WaitingRead;
+use crate::{backup, gains, gripper, registers, tolerance};
 
 /// Reported by get system version (0x02): 7.0, the vendor's 280 M5 generation.
 const SYSTEM_VERSION_X10: u8 = 70;
 /// Reported by get modify version (0x01).
 const MODIFY_VERSION: u8 = 0;
-
-/// What get servo status (0xE4) reports for a servo that does not answer: every bit set, a
-/// value no answering servo reports (its status register has six fault bits).
-const NO_ANSWER_STATUS: u8 = 0xFF;
 
 /// Handles one request; returns the reply (none only when the reply waits for the bus).
 pub(crate) fn handle<I: AtomIo>(
@@ -99,10 +97,9 @@ fn execute<I: AtomIo>(
         motion,
         gripper,
         drag,
-        gains,
         dispenser,
         errors,
-        ..
+        waiting,
     } = p;
     match request {
         // --- status and system ---
@@ -122,19 +119,12 @@ fn execute<I: AtomIo>(
         R::PowerOn => {
             settings.set_free_mode(false);
             if bank.powered() {
-                // Already on (the Basic says so at its boot): a running move goes on; only
-                // a servo released since gets its torque back.
-                let mut ok = true;
-                for i in 0..SERVOS {
-                    if !bank.enabled(i) {
-                        ok &= bank.set_torque(settings, i, true);
-                    }
-                }
-                return done_if(ok);
+                // Already on (the Basic says so at its boot): a running move goes on.
+                return done_if(bank.focus_released(settings));
             }
             let ok = bank.power(settings, true);
             // Hold where the arm is now instead of jumping to an old goal.
-            motion.stop(now_us, bank, settings);
+            motion.stop(&mut Context::new(now_us, bank, settings));
             done_if(ok)
         }
         R::PowerOff => {
@@ -148,7 +138,9 @@ fn execute<I: AtomIo>(
         }
         R::IsControllerConnected => byte(true),
         R::ReadNextError => Answer::Now(Reply::ServoErrors(core::array::from_fn(|i| {
-            servo_error(bank.health(i)).code()
+            bank.health(i)
+                .map_or(ServoErrorCode::Ok, ServoHealth::error_code)
+                .code()
         }))),
         R::SetFreshMode { fresh } => {
             settings.set_fresh_mode(fresh);
@@ -164,95 +156,116 @@ fn execute<I: AtomIo>(
         R::GetRebootCount => Answer::Now(Reply::Int16(0)),
 
         // --- motion ---
-        R::GetAngles => Answer::Now(Reply::Angles(bank.present_angles(settings))),
+        R::GetAngles => Answer::Now(Reply::Angles(bank.present_angles(now_us, settings))),
         R::SendAngle {
             joint,
             angle,
             speed,
         } => {
-            let target = Target::joints(one_joint(joint.index(), angle), speed.get());
-            Answer::Done(motion.submit(now_us, target, bank, settings))
+            let target = Target::joint(joint.index(), angle, speed.get());
+            let cx = &mut Context::new(now_us, bank, settings);
+            Answer::Done(motion.command(cx, Command::Move(target)))
         }
         R::SendAngles { angles, speed } => {
             let target = Target::joints(angles.map(Some), speed.get());
-            Answer::Done(motion.submit(now_us, target, bank, settings))
+            let cx = &mut Context::new(now_us, bank, settings);
+            Answer::Done(motion.command(cx, Command::Move(target)))
         }
         R::GetCoords => {
-            let present = bank.present_angles(settings);
-            Answer::Now(Reply::Coords(for_client(
-                settings.cart_mut().forward(&present),
-            )))
+            let present = bank.present_angles(now_us, settings);
+            Answer::Now(Reply::Coords(for_client(settings.cart().forward(&present))))
         }
-        R::AnglesToCoords { angles } => Answer::Now(Reply::Coords(for_client(
-            settings.cart_mut().forward(&angles),
-        ))),
+        R::AnglesToCoords { angles } => {
+            Answer::Now(Reply::Coords(for_client(settings.cart().forward(&angles))))
+        }
         R::SendCoord { target, speed } => {
-            let pose = planned_pose(p).with(target);
-            let mode = p.settings.cart().movement;
-            Answer::Done(move_to_pose(p, now_us, pose, speed.get(), mode))
+            let mode = settings.cart().movement();
+            let cx = &mut Context::new(now_us, bank, settings);
+            let pose = motion.planned_pose(cx).with(target);
+            let to_pose = Command::ToPose {
+                pose,
+                speed_percent: speed.get(),
+                mode,
+            };
+            Answer::Done(motion.command(cx, to_pose))
         }
         R::SendCoords { pose, speed, mode } => {
-            let mode = mode.unwrap_or(settings.cart().movement);
-            Answer::Done(move_to_pose(p, now_us, pose, speed.get(), mode))
+            let mode = mode.unwrap_or(settings.cart().movement());
+            let cx = &mut Context::new(now_us, bank, settings);
+            let to_pose = Command::ToPose {
+                pose,
+                speed_percent: speed.get(),
+                mode,
+            };
+            Answer::Done(motion.command(cx, to_pose))
         }
         R::Pause => {
-            motion.pause(now_us, bank, settings);
+            motion.pause(&mut Context::new(now_us, bank, settings));
             done()
         }
         R::IsPaused => byte(motion.is_paused()),
-        R::Resume => Answer::Done(motion.resume(now_us, bank, settings)),
+        R::Resume => Answer::Done(motion.resume(&mut Context::new(now_us, bank, settings))),
         R::Stop | R::JogStop => {
-            motion.stop(now_us, bank, settings);
+            motion.stop(&mut Context::new(now_us, bank, settings));
             done()
         }
         R::IsInPosition { target } => {
             // Near the target and at rest: pymycobot's sync_send_angles returns as soon as this
             // says 1, so a pose passed through on the way does not count.
-            let present = bank.present_angles(settings);
+            let present = bank.present_angles(now_us, settings);
             let near = match target {
-                PositionTarget::Angles(a) => angles_match(&present, &a),
+                PositionTarget::Angles(a) => tolerance::angles_match(&present, &a),
                 PositionTarget::Coords(pose) => {
-                    coords_match(&settings.cart_mut().forward(&present), &pose)
+                    tolerance::coords_match(&settings.cart().forward(&present), &pose)
                 }
             };
-            byte(near && !is_moving(p))
+            byte(near && !motion.is_moving(bank, now_us))
         }
-        R::IsMoving => byte(is_moving(p)),
+        R::IsMoving => byte(motion.is_moving(bank, now_us)),
         // No solution: `00` (pymycobot then returns 0, never a list of angles) and error 32.
         R::SolveIk { target, current } => match settings.cart().inverse(&target, &current) {
             Ok(q) => Answer::Now(Reply::Angles(q)),
             Err(e) => Answer::Done(Err(e.into())),
         },
         R::GetAnglesCoords => {
-            let angles = bank.present_angles(settings);
-            let coords = for_client(settings.cart_mut().forward(&angles));
+            let angles = bank.present_angles(now_us, settings);
+            let coords = for_client(settings.cart().forward(&angles));
             Answer::Now(Reply::AnglesAndCoords { angles, coords })
         }
-        R::GetPlannedAngles => Answer::Now(Reply::Angles(motion.planned_angles(bank, settings))),
-        R::GetPlannedCoords => Answer::Now(Reply::Coords(for_client(planned_pose(p)))),
-        R::MoveCCoords { begin, middle, end } => Answer::Done(motion.submit_arc(
-            now_us,
-            Some(begin),
-            middle,
-            end,
-            settings.speed_percent(),
-            bank,
-            settings,
-        )),
-        R::MoveCCoordsFromHere { middle, end } => Answer::Done(motion.submit_arc(
-            now_us,
-            None,
-            middle,
-            end,
-            settings.speed_percent(),
-            bank,
-            settings,
-        )),
-        R::SetPid { gains: values } => Answer::Done(gains.set(bank, settings, values)),
-        R::GetPid => match gains.read(bank, settings, link) {
-            Ok(()) => Answer::Later,
-            Err(e) => Answer::Done(Err(e)),
-        },
+        R::GetPlannedAngles => {
+            let cx = &Context::new(now_us, bank, settings);
+            Answer::Now(Reply::Angles(motion.planned_angles(cx)))
+        }
+        R::GetPlannedCoords => {
+            let cx = &Context::new(now_us, bank, settings);
+            Answer::Now(Reply::Coords(for_client(motion.planned_pose(cx))))
+        }
+        R::MoveCCoords { begin, middle, end } => {
+            let arc = Command::Arc {
+                begin: Some(begin),
+                via: middle,
+                end,
+                speed_percent: settings.speed_percent(),
+            };
+            Answer::Done(motion.command(&mut Context::new(now_us, bank, settings), arc))
+        }
+        R::MoveCCoordsFromHere { middle, end } => {
+            let arc = Command::Arc {
+                begin: None,
+                via: middle,
+                end,
+                speed_percent: settings.speed_percent(),
+            };
+            Answer::Done(motion.command(&mut Context::new(now_us, bank, settings), arc))
+        }
+        R::SetPid { gains: values } => Answer::Done(gains::set(bank, settings, values)),
+        R::GetPid => later(gains::reads(settings).and_then(|(ids, ops)| {
+            let pid = WaitingRead::Pid {
+                ids,
+                got: [None; 2],
+            };
+            waiting.start(bank, link, pid, &ops)
+        })),
         R::MoveRound => Answer::Done(dispenser.turn(now_us, io)),
         R::SetFourPiecesZero => byte(dispenser.zero(io)),
 
@@ -261,61 +274,70 @@ fn execute<I: AtomIo>(
             joint,
             direction,
             speed,
-        } => Answer::Done(motion.jog_joint(
-            now_us,
-            joint.index(),
-            dir(direction),
-            speed.get(),
-            bank,
-            settings,
-        )),
+        } => {
+            let jog = Command::JogJoint {
+                joint: joint.index(),
+                direction: dir(direction),
+                speed_percent: speed.get(),
+            };
+            Answer::Done(motion.command(&mut Context::new(now_us, bank, settings), jog))
+        }
         R::JogRpy {
             axis,
             direction,
             speed,
-        } => Answer::Done(motion.jog_pose(
-            now_us,
-            3 + axis as usize - 1,
-            dir(direction),
-            speed.get(),
-            bank,
-            settings,
-        )),
+        } => {
+            let jog = Command::JogPose {
+                axis: 3 + axis as usize - 1,
+                direction: dir(direction),
+                speed_percent: speed.get(),
+            };
+            Answer::Done(motion.command(&mut Context::new(now_us, bank, settings), jog))
+        }
         R::JogCoord {
             axis,
             direction,
             speed,
-        } => Answer::Done(motion.jog_pose(
-            now_us,
-            axis.index(),
-            dir(direction),
-            speed.get(),
-            bank,
-            settings,
-        )),
+        } => {
+            let jog = Command::JogPose {
+                axis: axis.index(),
+                direction: dir(direction),
+                speed_percent: speed.get(),
+            };
+            Answer::Done(motion.command(&mut Context::new(now_us, bank, settings), jog))
+        }
         R::JogIncrementAngle {
             joint,
             increment,
             speed,
         } => {
             let j = joint.index();
-            let base = motion.planned_angles(bank, settings);
-            let from = base.get(j).copied().unwrap_or_default();
+            let cx = &mut Context::new(now_us, bank, settings);
+            let from = motion
+                .planned_angles(cx)
+                .get(j)
+                .copied()
+                .unwrap_or_default();
             let Ok(goal) = i16::try_from(i32::from(from.0) + i32::from(increment.0)) else {
                 return Answer::Done(Err(AtomError::JointLimit(j)));
             };
-            let target = Target::joints(one_joint(j, Centideg(goal)), speed.get());
-            Answer::Done(motion.submit(now_us, target, bank, settings))
+            let target = Target::joint(j, Centideg(goal), speed.get());
+            Answer::Done(motion.command(cx, Command::Move(target)))
         }
         R::JogIncrementCoord { increment, speed } => {
-            let base = planned_pose(p);
+            let cx = &mut Context::new(now_us, bank, settings);
+            let base = motion.planned_pose(cx);
             let axis = increment.axis();
             let goal = i32::from(base.get(axis).raw()) + i32::from(increment.raw());
             let Ok(goal) = i16::try_from(goal) else {
                 return Answer::Done(Err(AtomError::Unreachable));
             };
-            let pose = base.with(protocol_core::command::AxisValue::new(axis, goal));
-            Answer::Done(move_to_pose(p, now_us, pose, speed.get(), MoveMode::Joint))
+            let to_pose = Command::ToPose {
+                pose: base.with(protocol_core::command::AxisValue::new(axis, goal)),
+                speed_percent: speed.get(),
+                mode: MoveMode::Joint,
+            };
+            Answer::Done(motion.command(cx, to_pose))
         }
 
         // --- encoders, speed, limits ---
@@ -326,40 +348,39 @@ fn execute<I: AtomIo>(
         } => {
             let speed = speed.map_or(settings.speed_percent(), |s| s.get());
             let index = usize::from(servo.get()) - 1;
+            let cx = &mut Context::new(now_us, bank, settings);
             if index == GRIPPER {
-                return Answer::Done(crate::gripper::move_steps(bank, settings, encoder, speed));
+                return Answer::Done(gripper::move_steps(cx, encoder, speed));
             }
-            if encoder != clamp_steps(encoder) {
+            if !in_encoder_range(encoder) {
                 return Answer::Done(Err(AtomError::JointLimit(index)));
             }
-            let angle = settings.angle(index, encoder);
-            let target = Target::joints(one_joint(index, angle), speed);
-            Answer::Done(motion.submit(now_us, target, bank, settings))
+            let target = Target::joint(index, settings.angle(index, encoder), speed);
+            Answer::Done(motion.command(cx, Command::Move(target)))
         }
         R::GetEncoder { servo } => {
             let index = usize::from(servo.get()) - 1;
             Answer::Now(Reply::Int16(bank.health(index).map_or(0, |h| h.position.0)))
         }
         R::SetEncoders { encoders, speed } => {
-            if let Some(j) = encoders.iter().position(|&e| e != clamp_steps(e)) {
+            if let Some(j) = encoders.iter().position(|&e| !in_encoder_range(e)) {
                 return Answer::Done(Err(AtomError::JointLimit(j)));
             }
             let angles = core::array::from_fn(|j| {
                 Some(settings.angle(j, encoders.get(j).copied().unwrap_or_default()))
             });
             let target = Target::joints(angles, speed.get());
-            Answer::Done(motion.submit(now_us, target, bank, settings))
+            let cx = &mut Context::new(now_us, bank, settings);
+            Answer::Done(motion.command(cx, Command::Move(target)))
         }
         R::GetEncoders => Answer::Now(Reply::Encoders(bank.present_steps())),
         R::SetEncodersDrag {
             encoders,
             speeds_steps_per_s,
-        } => Answer::Done(registers::drag_to(
-            bank,
-            settings,
-            encoders,
-            speeds_steps_per_s,
-        )),
+        } => {
+            let cx = &mut Context::new(now_us, bank, settings);
+            Answer::Done(registers::drag_to(cx, encoders, speeds_steps_per_s))
+        }
         R::GetSpeed => Answer::Now(Reply::Byte(settings.speed_percent())),
         R::SetSpeed { speed } => {
             settings.set_speed_percent(speed.get());
@@ -390,26 +411,38 @@ fn execute<I: AtomIo>(
             servo,
             address,
             value,
-        } => Answer::Done(access(p).write(now_us, usize::from(servo.get()) - 1, address, value)),
+        } => {
+            let index = usize::from(servo.get()) - 1;
+            let cx = &mut Context::new(now_us, bank, settings);
+            Answer::Done(registers::write(cx, motion, gripper, index, address, value))
+        }
         R::GetServoData {
             servo,
             address,
             width,
         } => {
             let two_bytes = width == Some(DataWidth::Word);
-            match access(p).read(usize::from(servo.get()) - 1, address, two_bytes, link) {
-                Ok(()) => Answer::Later,
-                Err(e) => Answer::Done(Err(e)),
-            }
+            let index = usize::from(servo.get()) - 1;
+            later(
+                registers::read(settings, index, address, two_bytes).and_then(|op| {
+                    let read = WaitingRead::ServoData { two_bytes };
+                    waiting.start(bank, link, read, &[op])
+                }),
+            )
         }
         R::SetServoCalibration { servo } => {
-            Answer::Done(access(p).calibrate(now_us, usize::from(servo.get()) - 1))
+            let index = usize::from(servo.get()) - 1;
+            let cx = &mut Context::new(now_us, bank, settings);
+            Answer::Done(registers::calibrate(cx, motion, gripper, index))
         }
-        R::JointBrake { servo } => Answer::Done(access(p).brake(usize::from(servo.get()) - 1)),
+        R::JointBrake { servo } => {
+            let cx = &mut Context::new(now_us, bank, settings);
+            Answer::Done(registers::brake(cx, usize::from(servo.get()) - 1))
+        }
         R::ReleaseServo { servo, .. } => {
             let index = usize::from(servo.get()) - 1;
             if index < JOINTS {
-                motion.halt(now_us, bank, settings);
+                motion.halt(&mut Context::new(now_us, bank, settings));
             }
             done_if(bank.set_torque(settings, index, false))
         }
@@ -419,30 +452,27 @@ fn execute<I: AtomIo>(
                 done_if(bank.set_torque(settings, usize::from(s.get()) - 1, true))
             }
         },
-        R::GetServoSpeeds => Answer::Now(Reply::Int16x6(per_joint(p, |h| h.speed_steps_per_s))),
-        R::GetServoCurrents => Answer::Now(Reply::Int16x6(per_joint(p, |h| {
-            // The STS current register counts 6.5 mA units.
-            (i32::from(h.current_raw) * 65 / 10).clamp(-32_768, 32_767) as i16
-        }))),
-        R::GetServoVoltages => Answer::Now(Reply::Bytes6(per_joint(p, |h| h.voltage_decivolt))),
-        R::GetServoStatus => Answer::Now(Reply::Bytes6(per_joint(p, |h| {
-            if h.answering {
-                h.fault_bits
-            } else {
-                NO_ANSWER_STATUS
-            }
-        }))),
-        R::GetServoTemps => Answer::Now(Reply::Bytes6(per_joint(p, |h| h.temperature_c))),
+        R::GetServoSpeeds => Answer::Now(Reply::Int16x6(bank.per_joint(|h| h.speed_steps_per_s))),
+        R::GetServoCurrents => Answer::Now(Reply::Int16x6(
+            bank.per_joint(ServoHealth::current_milliamps),
+        )),
+        R::GetServoVoltages => Answer::Now(Reply::Bytes6(bank.per_joint(|h| h.voltage_decivolt))),
+        R::GetServoStatus => Answer::Now(Reply::Bytes6(bank.per_joint(ServoHealth::status_byte))),
+        R::GetServoTemps => Answer::Now(Reply::Bytes6(bank.per_joint(|h| h.temperature_c))),
         R::BackupServoParams { servo } | R::RestoreServoParams { servo } => {
             let restore = matches!(request, R::RestoreServoParams { .. });
             let has_store = io.param_store().is_some();
-            match p
-                .backups
-                .start(restore, servo, link, has_store, &mut p.bank, &p.settings)
-            {
-                Ok(()) => Answer::Later,
-                Err(e) => Answer::Done(Err(e)),
-            }
+            let cx = &Context::new(now_us, bank, settings);
+            later(
+                backup::reads(cx, servo, has_store).and_then(|(ops, servos)| {
+                    let params = WaitingRead::Params {
+                        restore,
+                        waiting: servos,
+                        ok: true,
+                    };
+                    waiting.start(bank, link, params, &ops)
+                }),
+            )
         }
 
         // --- Atom IO, LED, gripper ---
@@ -475,16 +505,22 @@ fn execute<I: AtomIo>(
         ),
         R::GetGripperValue { .. } => Answer::Now(Reply::Byte(gripper.value(bank))),
         R::SetGripperStateNoSpeed { state } => {
-            Answer::Done(gripper.set_state(bank, settings, state, 50))
+            let cx = &mut Context::new(now_us, bank, settings);
+            Answer::Done(gripper.set_state(cx, state, 50))
         }
         R::SetGripperState { state, speed, .. } => {
-            Answer::Done(gripper.set_state(bank, settings, state, speed.get()))
+            let cx = &mut Context::new(now_us, bank, settings);
+            Answer::Done(gripper.set_state(cx, state, speed.get()))
         }
         R::SetGripperValue { value, speed, .. } => {
-            Answer::Done(gripper.move_to(bank, settings, value.get(), speed.get()))
+            let cx = &mut Context::new(now_us, bank, settings);
+            Answer::Done(gripper.move_to(cx, value.get(), speed.get()))
         }
-        R::SetGripperCalibration => Answer::Done(access(p).calibrate(now_us, GRIPPER)),
-        R::IsGripperMoving => byte(bank.servo_moving(GRIPPER)),
+        R::SetGripperCalibration => {
+            let cx = &mut Context::new(now_us, bank, settings);
+            Answer::Done(registers::calibrate(cx, motion, gripper, GRIPPER))
+        }
+        R::IsGripperMoving => byte(bank.servo_moving(now_us, GRIPPER)),
         R::SetColor { rgb } => {
             io.set_rgb(rgb.r, rgb.g, rgb.b);
             done()
@@ -495,7 +531,10 @@ fn execute<I: AtomIo>(
         }
         R::GetHtsGripperTorque => Answer::Now(Reply::Int16(gripper.torque())),
         R::GetGripperProtectCurrent => Answer::Now(Reply::Int16(gripper.protect_current())),
-        R::InitGripper => byte(access(p).calibrate(now_us, GRIPPER).is_ok()),
+        R::InitGripper => {
+            let cx = &mut Context::new(now_us, bank, settings);
+            byte(registers::calibrate(cx, motion, gripper, GRIPPER).is_ok())
+        }
         R::SetGripperProtectCurrent { current } => {
             gripper.set_protect_current(current);
             done()
@@ -510,38 +549,30 @@ fn execute<I: AtomIo>(
 
         // --- coordinate frames ---
         R::SetToolReference { pose } => {
-            let cart = settings.cart_mut();
-            cart.tool = pose;
-            cart.apply_frames();
+            settings.set_tool(pose);
             done()
         }
-        R::GetToolReference => Answer::Now(Reply::Coords(settings.cart().tool)),
+        R::GetToolReference => Answer::Now(Reply::Coords(settings.cart().tool())),
         R::SetWorldReference { pose } => {
-            let cart = settings.cart_mut();
-            cart.world = pose;
-            cart.apply_frames();
+            settings.set_world(pose);
             done()
         }
-        R::GetWorldReference => Answer::Now(Reply::Coords(settings.cart().world)),
+        R::GetWorldReference => Answer::Now(Reply::Coords(settings.cart().world())),
         R::SetReferenceFrame { frame } => {
-            let cart = settings.cart_mut();
-            cart.reference = frame;
-            cart.apply_frames();
+            settings.set_reference(frame);
             done()
         }
-        R::GetReferenceFrame => Answer::Now(Reply::Byte(settings.cart().reference as u8)),
+        R::GetReferenceFrame => Answer::Now(Reply::Byte(settings.cart().reference() as u8)),
         R::SetMovementType { mode } => {
-            settings.cart_mut().movement = mode;
+            settings.set_movement(mode);
             done()
         }
-        R::GetMovementType => Answer::Now(Reply::Byte(settings.cart().movement as u8)),
+        R::GetMovementType => Answer::Now(Reply::Byte(settings.cart().movement() as u8)),
         R::SetEndType { end } => {
-            let cart = settings.cart_mut();
-            cart.end = end;
-            cart.apply_frames();
+            settings.set_end(end);
             done()
         }
-        R::GetEndType => Answer::Now(Reply::Byte(match settings.cart().end {
+        R::GetEndType => Answer::Now(Reply::Byte(match settings.cart().end() {
             EndType::Flange => 0,
             EndType::Tool => 1,
         })),
@@ -560,61 +591,12 @@ fn execute<I: AtomIo>(
     }
 }
 
-/// The parts a single-servo access touches.
-fn access(p: &mut Parts) -> ServoAccess<'_> {
-    ServoAccess {
-        bank: &mut p.bank,
-        settings: &p.settings,
-        motion: &mut p.motion,
-        gripper: &mut p.gripper,
+/// A request whose reply waits for servo reads: later if they were queued, refused if not.
+fn later(queued: Result<(), AtomError>) -> Answer {
+    match queued {
+        Ok(()) => Answer::Later,
+        Err(e) => Answer::Done(Err(e)),
     }
-}
-
-/// True while the arm moves (a motion runs or a joint reports moving).
-pub(crate) fn is_moving(p: &Parts) -> bool {
-    p.motion.is_active() || p.bank.joints_moving()
-}
-
-/// The end pose the arm is going to (the present pose when idle).
-fn planned_pose(p: &mut Parts) -> Pose {
-    if let Some(pose) = p.motion.planned_pose() {
-        return pose;
-    }
-    let angles = p.motion.planned_angles(&p.bank, &p.settings);
-    p.settings.cart_mut().forward(&angles)
-}
-
-/// Moves the end to `pose`: joint-interpolated (mode 0) or along a straight line (mode 1).
-fn move_to_pose(
-    p: &mut Parts,
-    now_us: u64,
-    pose: Pose,
-    speed_percent: u8,
-    mode: MoveMode,
-) -> Result<(), AtomError> {
-    if !p.bank.powered() {
-        return Err(AtomError::PoweredOff);
-    }
-    let seed = p.motion.planned_angles(&p.bank, &p.settings);
-    let angles = p.settings.cart().inverse(&pose, &seed)?;
-    let target = Target {
-        angles: angles.map(Some),
-        speed_percent,
-        way: match mode {
-            MoveMode::Linear => Way::Line(pose),
-            MoveMode::Joint => Way::Joints,
-        },
-    };
-    p.motion.submit(now_us, target, &mut p.bank, &p.settings)
-}
-
-/// Angles with only joint `j` given.
-fn one_joint(j: usize, angle: Centideg) -> [Option<Centideg>; JOINTS] {
-    let mut angles = [None; JOINTS];
-    if let Some(slot) = angles.get_mut(j) {
-        *slot = Some(angle);
-    }
-    angles
 }
 
 /// A count of drag-teaching points as the int16 the host reads (at most 1 000).
@@ -629,37 +611,96 @@ fn dir(d: Direction) -> JogDirection {
     }
 }
 
-/// An encoder value limited to the servo's range 0..=4095 (`Steps` from the wire may be 4096).
-fn clamp_steps(s: Steps) -> Steps {
-    Steps(s.0.clamp(0, 4095))
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::powered;
+    use crate::config::AtomConfig;
+    use crate::io::RecordingIo;
+    use crate::settings::Settings;
 
-/// Positions within 2 mm and orientations within 1 degree count as in position.
-fn coords_match(a: &Pose, b: &Pose) -> bool {
-    let (a, b) = (a.to_array(), b.to_array());
-    a.iter().zip(&b).enumerate().all(|(i, (x, y))| {
-        let diff = (i32::from(*x) - i32::from(*y)).abs();
-        if i < 3 {
-            diff <= 20
-        } else {
-            // Angles wrap at +-180 degrees.
-            diff.min(36_000 - diff) <= 100
-        }
-    })
-}
+    fn ask(parts: &mut Parts, code: u8, data: &[u8]) -> Option<std::vec::Vec<u8>> {
+        let frame = Frame::new(code, data).unwrap();
+        let reply = handle(parts, 0, &frame, Link::Usb, &mut RecordingIo::default())?;
+        assert_eq!(reply.cmd(), code, "a reply carries its request's CMD byte");
+        Some(reply.data().to_vec())
+    }
 
-fn per_joint<T: Default + Copy>(p: &Parts, f: impl Fn(&ServoHealth) -> T) -> [T; JOINTS] {
-    core::array::from_fn(|j| p.bank.health(j).map(&f).unwrap_or_default())
-}
+    /// Send angle (0x21): joint 1 to `degrees` at 50 %.
+    fn send_angle_1(parts: &mut Parts, degrees: i16) -> Option<std::vec::Vec<u8>> {
+        let mut data = std::vec![1];
+        data.extend_from_slice(&(degrees * 100).to_be_bytes());
+        data.push(50);
+        ask(parts, cmd::SEND_ANGLE, &data)
+    }
 
-/// One servo's entry of read next error (0x15, `ServoErrorCode`).
-fn servo_error(health: Option<&ServoHealth>) -> ServoErrorCode {
-    match health {
-        Some(h) if !h.answering && h.corrupt_answers => ServoErrorCode::BadAnswer,
-        Some(h) if !h.answering => ServoErrorCode::NoAnswer,
-        Some(h) if h.fault_bits & ServoErrorCode::FAULT_MASK != 0 => {
-            ServoErrorCode::Fault(h.fault_bits)
-        }
-        _ => ServoErrorCode::Ok,
+    #[test]
+    fn a_refused_motion_answers_00_and_records_its_code_for_0x07() {
+        let mut parts = Parts::new(powered());
+        assert_eq!(
+            send_angle_1(&mut parts, 170),
+            Some(std::vec![0]),
+            "J1 ends at 168 deg"
+        );
+        assert_eq!(
+            ask(&mut parts, cmd::GET_ERROR_INFO, &[]),
+            Some(std::vec![1])
+        );
+        assert!(!parts.motion.is_active(), "nothing moves");
+    }
+
+    #[test]
+    fn a_motion_while_powered_off_is_refused_without_an_error_code() {
+        let mut parts = Parts::new(Settings::new(AtomConfig::default()));
+        assert_eq!(send_angle_1(&mut parts, 10), Some(std::vec![0]));
+        assert_eq!(
+            ask(&mut parts, cmd::GET_ERROR_INFO, &[]),
+            Some(std::vec![0])
+        );
+    }
+
+    #[test]
+    fn an_accepted_motion_becomes_goals_for_the_servos() {
+        let mut parts = Parts::new(powered());
+        assert_eq!(send_angle_1(&mut parts, 10), Some(std::vec![1]));
+        assert!(parts.motion.is_active());
+        assert!(parts.bank.take_goal_write(&parts.settings).is_some());
+    }
+
+    #[test]
+    fn a_frame_setting_reads_back_as_set() {
+        let mut parts = Parts::new(powered());
+        let tool: std::vec::Vec<u8> = [100i16, 0, 500, 0, 0, 9_000]
+            .iter()
+            .flat_map(|v| v.to_be_bytes())
+            .collect();
+        assert_eq!(
+            ask(&mut parts, cmd::SET_TOOL_REFERENCE, &tool),
+            Some(std::vec![1])
+        );
+        assert_eq!(ask(&mut parts, cmd::GET_TOOL_REFERENCE, &[]), Some(tool));
+        assert_eq!(ask(&mut parts, cmd::SET_END_TYPE, &[1]), Some(std::vec![1]));
+        assert_eq!(ask(&mut parts, cmd::GET_END_TYPE, &[]), Some(std::vec![1]));
+    }
+
+    #[test]
+    fn a_servo_data_read_answers_later_through_the_bank() {
+        let mut parts = Parts::new(powered());
+        assert_eq!(ask(&mut parts, cmd::GET_SERVO_DATA, &[2, 56]), None);
+        assert_eq!(
+            parts.bank.due_job(),
+            Some(crate::driver::Op::Read {
+                id: 2,
+                addr: 56,
+                count: 1
+            })
+        );
+    }
+
+    #[test]
+    fn a_frame_that_is_no_valid_command_answers_00() {
+        let mut parts = Parts::new(powered());
+        assert_eq!(ask(&mut parts, 0xEE, &[]), Some(std::vec![0]));
+        assert_eq!(ask(&mut parts, cmd::SEND_ANGLE, &[1]), Some(std::vec![0]));
     }
 }

@@ -15,6 +15,11 @@ pub const STEPS_PER_TURN: i32 = 4096;
 /// Encoder reading at 0 degrees.
 pub const STEPS_ZERO: i32 = 2048;
 
+/// True if `steps` is an encoder position, 0..=4095 (a value from the wire may be 4096).
+pub fn in_encoder_range(steps: Steps) -> bool {
+    (0..STEPS_PER_TURN).contains(&i32::from(steps.0))
+}
+
 /// Direction of a joint: whether more encoder steps mean more degrees.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum JointSign {

@@ -2,8 +2,9 @@
 //!
 //! A transaction is one instruction packet and, for PING and READ, the one status packet that
 //! answers it. The driver sends the instruction, matches the answer by servo id and reports
-//! the outcome; retries and the gap between transactions are the caller's scheduling decision
-//! ([`crate::Atom`] retries a bounded number of times and waits
+//! the outcome; retries and the gap between transactions are the callers' decisions (the servo
+//! bank keeps a timed-out operation queued for a bounded number of retries, and the bus
+//! schedule waits
 //! [`ATOM_TRANSACTION_GAP_US`](protocol_core::timing::ATOM_TRANSACTION_GAP_US) of silence).
 
 use heapless::Vec;

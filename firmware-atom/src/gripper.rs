@@ -9,9 +9,10 @@ use protocol_core::command::GripperState;
 use protocol_core::units::Steps;
 
 use crate::bank::ServoBank;
-use crate::config::{GRIPPER, GripperRange, SERVOS, STEPS_ZERO};
+use crate::config::{GRIPPER, GripperRange, STEPS_ZERO};
+use crate::context::Context;
 use crate::error::AtomError;
-use crate::safety::{Goal, GoalSet};
+use crate::safety::{Goal, Goals};
 use crate::settings::Settings;
 
 /// The gripper's range and settings.
@@ -47,16 +48,15 @@ impl Gripper {
     /// Opens (100), closes (0) or releases the gripper (0x66); speed 0 stops it where it is.
     pub fn set_state(
         &self,
-        bank: &mut ServoBank,
-        settings: &Settings,
+        cx: &mut Context<'_>,
         state: GripperState,
         speed_percent: u8,
     ) -> Result<(), AtomError> {
         match state {
-            GripperState::Open => self.move_to(bank, settings, 100, speed_percent),
-            GripperState::Close => self.move_to(bank, settings, 0, speed_percent),
+            GripperState::Open => self.move_to(cx, 100, speed_percent),
+            GripperState::Close => self.move_to(cx, 0, speed_percent),
             GripperState::Release => {
-                if bank.set_torque(settings, GRIPPER, false) {
+                if cx.bank.set_torque(cx.settings, GRIPPER, false) {
                     Ok(())
                 } else {
                     Err(AtomError::Busy)
@@ -68,18 +68,17 @@ impl Gripper {
     /// Moves the gripper to opening `value` 0..=100 (0x67); speed 0 stops it where it is.
     pub fn move_to(
         &self,
-        bank: &mut ServoBank,
-        settings: &Settings,
+        cx: &mut Context<'_>,
         value: u8,
         speed_percent: u8,
     ) -> Result<(), AtomError> {
         if speed_percent == 0 {
-            return stop(bank, settings);
+            return stop(cx);
         }
         let closed = i32::from(self.range.closed.0);
         let open = i32::from(self.range.open.0);
         let steps = closed + (open - closed) * i32::from(value.min(100)) / 100;
-        move_steps(bank, settings, Steps(steps as i16), speed_percent)
+        move_steps(cx, Steps(steps as i16), speed_percent)
     }
 
     /// Follows a calibration of the gripper servo (its present position became 2048): that
@@ -113,33 +112,21 @@ impl Gripper {
 
 /// Stops the gripper where it is: braking at the servo's full deceleration, the goal where it
 /// comes to rest. A released gripper stays released.
-fn stop(bank: &mut ServoBank, settings: &Settings) -> Result<(), AtomError> {
-    let mut goals: GoalSet = [None; SERVOS];
-    if let Some(slot) = goals.get_mut(GRIPPER) {
-        *slot = crate::motion::stop_one(bank, settings, GRIPPER);
+fn stop(cx: &mut Context<'_>) -> Result<(), AtomError> {
+    match crate::motion::stop_one(cx, GRIPPER) {
+        Some(goal) => cx.send_goals(Goals::one(GRIPPER, goal)),
+        None => Ok(()),
     }
-    if goals.iter().all(Option::is_none) {
-        return Ok(());
-    }
-    bank.send_goals(settings, goals)
 }
 
 /// Moves the gripper servo to an encoder position at `speed_percent` of the joint speed (a
 /// released gripper is switched on by the bank before its goal is written).
-pub fn move_steps(
-    bank: &mut ServoBank,
-    settings: &Settings,
-    steps: Steps,
-    speed_percent: u8,
-) -> Result<(), AtomError> {
-    let config = settings.config();
-    let mut goals: GoalSet = [None; SERVOS];
-    if let Some(slot) = goals.get_mut(GRIPPER) {
-        *slot = Some(Goal {
-            position: steps,
-            speed_steps_per_s: config.joint_speed_steps(speed_percent.max(1)) as u16,
-            accel: config.joint_accel_register(),
-        });
-    }
-    bank.send_goals(settings, goals)
+pub fn move_steps(cx: &mut Context<'_>, steps: Steps, speed_percent: u8) -> Result<(), AtomError> {
+    let config = cx.settings.config();
+    let goal = Goal {
+        position: steps,
+        speed_steps_per_s: config.joint_speed_steps(speed_percent.max(1)) as u16,
+        accel: config.joint_accel_register(),
+    };
+    cx.send_goals(Goals::one(GRIPPER, goal))
 }

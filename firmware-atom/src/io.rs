@@ -39,18 +39,6 @@ pub enum PinMode {
     InputPullUp,
 }
 
-impl PinMode {
-    /// The mode for a wire byte of command 0x60 (0 in, 1 out, 2 in pull-up).
-    pub fn from_wire(mode: u8) -> Option<Self> {
-        match mode {
-            0 => Some(Self::Input),
-            1 => Some(Self::Output),
-            2 => Some(Self::InputPullUp),
-            _ => None,
-        }
-    }
-}
-
 /// Pins, PWM, the RGB LEDs and the button of the Atom. Implemented by the board layer (GPIO,
 /// LEDC, RMT) and by the virtual robot. Every method returns at once.
 pub trait AtomIo {

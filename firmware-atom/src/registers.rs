@@ -26,14 +26,13 @@ use protocol_core::command::ServoValue;
 use protocol_core::servo::{reg, sign_magnitude};
 use protocol_core::units::Steps;
 
-use crate::bank::{ServoBank, Then};
-use crate::config::{GRIPPER, JOINTS, SERVOS};
+use crate::config::{GRIPPER, JOINTS};
+use crate::context::Context;
 use crate::driver::Op;
 use crate::error::AtomError;
 use crate::gripper::{self, Gripper};
-use crate::link::Link;
 use crate::motion::MotionController;
-use crate::safety::{Goal, GoalSet};
+use crate::safety::{Goal, Goals};
 use crate::settings::Settings;
 
 /// Servo registers below this address are EEPROM: writes need the lock (55) opened first.
@@ -62,147 +61,122 @@ pub fn access(addr: u8) -> Access {
     }
 }
 
-/// The parts a servo access may touch.
-pub struct ServoAccess<'a> {
-    /// The servos.
-    pub bank: &'a mut ServoBank,
-    /// Limits and configuration.
-    pub settings: &'a Settings,
-    /// The motion (halted before a calibration).
-    pub motion: &'a mut MotionController,
-    /// The gripper's range (follows its calibration).
-    pub gripper: &'a mut Gripper,
+/// Writes a servo register for 0x52 (servo `index` 0..=6). See the [module doc](self). A
+/// torque write of 128 is a calibration ([`calibrate`]).
+pub fn write(
+    cx: &mut Context<'_>,
+    motion: &mut MotionController,
+    gripper: &mut Gripper,
+    index: usize,
+    addr: u8,
+    value: ServoValue,
+) -> Result<(), AtomError> {
+    let id = id(cx.settings, index)?;
+    let (data, len): ([u8; 2], u8) = match value {
+        ServoValue::Byte(b) => ([b, 0], 1),
+        ServoValue::Word(w) => (w.to_le_bytes(), 2),
+    };
+    let last = addr.checked_add(len - 1).ok_or(AtomError::Invalid)?;
+    let kinds = (access(addr), access(last));
+    match (kinds, value) {
+        ((Access::Torque, Access::Torque), ServoValue::Byte(128)) => {
+            return calibrate(cx, motion, gripper, index);
+        }
+        ((Access::Torque, Access::Torque), ServoValue::Byte(b)) => {
+            return if cx.bank.set_torque(cx.settings, index, b != 0) {
+                Ok(())
+            } else {
+                Err(AtomError::Invalid)
+            };
+        }
+        ((Access::Goal, Access::Goal), ServoValue::Word(w)) if addr == reg::GOAL_POSITION => {
+            return move_to_steps(cx, index, Steps(sign_magnitude(w, 15)));
+        }
+        ((Access::Write, Access::Write), _) => {}
+        _ => return Err(AtomError::Invalid),
+    }
+    let data = data.get(..usize::from(len)).ok_or(AtomError::Invalid)?;
+    let eeprom = addr < FIRST_RAM_REGISTER;
+    let needed = if eeprom { 3 } else { 1 };
+    if cx.bank.op_room() < needed {
+        return Err(AtomError::Busy);
+    }
+    let write = Op::write(id, addr, data).ok_or(AtomError::Invalid)?;
+    if eeprom && let Some(unlock) = Op::write(id, reg::EEPROM_LOCK, &[0]) {
+        cx.bank.queue_op(unlock);
+    }
+    cx.bank.queue_op(write);
+    if eeprom && let Some(lock) = Op::write(id, reg::EEPROM_LOCK, &[1]) {
+        cx.bank.queue_op(lock);
+    }
+    Ok(())
 }
 
-impl ServoAccess<'_> {
-    /// Writes a servo register for 0x52 (servo `index` 0..=6). See the [module doc](self).
-    pub fn write(
-        &mut self,
-        now_us: u64,
-        index: usize,
-        addr: u8,
-        value: ServoValue,
-    ) -> Result<(), AtomError> {
-        let id = self.id(index)?;
-        let (data, len): ([u8; 2], u8) = match value {
-            ServoValue::Byte(b) => ([b, 0], 1),
-            ServoValue::Word(w) => (w.to_le_bytes(), 2),
-        };
-        let last = addr.checked_add(len - 1).ok_or(AtomError::Invalid)?;
-        let kinds = (access(addr), access(last));
-        match (kinds, value) {
-            ((Access::Torque, Access::Torque), ServoValue::Byte(128)) => {
-                return self.calibrate(now_us, index);
-            }
-            ((Access::Torque, Access::Torque), ServoValue::Byte(b)) => {
-                return if self.bank.set_torque(self.settings, index, b != 0) {
-                    Ok(())
-                } else {
-                    Err(AtomError::Invalid)
-                };
-            }
-            ((Access::Goal, Access::Goal), ServoValue::Word(w)) if addr == reg::GOAL_POSITION => {
-                return self.move_to_steps(index, Steps(sign_magnitude(w, 15)));
-            }
-            ((Access::Write, Access::Write), _) => {}
-            _ => return Err(AtomError::Invalid),
-        }
-        let data = data.get(..usize::from(len)).ok_or(AtomError::Invalid)?;
-        let eeprom = addr < FIRST_RAM_REGISTER;
-        let needed = if eeprom { 3 } else { 1 };
-        if self.bank.op_room() < needed {
-            return Err(AtomError::Busy);
-        }
-        let write = Op::write(id, addr, data).ok_or(AtomError::Invalid)?;
-        if eeprom && let Some(unlock) = Op::write(id, reg::EEPROM_LOCK, &[0]) {
-            self.bank.queue_op(unlock, Then::Nothing);
-        }
-        self.bank.queue_op(write, Then::Nothing);
-        if eeprom && let Some(lock) = Op::write(id, reg::EEPROM_LOCK, &[1]) {
-            self.bank.queue_op(lock, Then::Nothing);
-        }
-        Ok(())
-    }
+/// The read of one or two bytes at `addr` of servo `index` (0x53).
+pub fn read(settings: &Settings, index: usize, addr: u8, two_bytes: bool) -> Result<Op, AtomError> {
+    Ok(Op::Read {
+        id: id(settings, index)?,
+        addr,
+        count: if two_bytes { 2 } else { 1 },
+    })
+}
 
-    /// Queues a read of one or two bytes at `addr` of servo `index` (0x53); the reply goes to
-    /// `link` when the read finishes.
-    pub fn read(
-        &mut self,
-        index: usize,
-        addr: u8,
-        two_bytes: bool,
-        link: Link,
-    ) -> Result<(), AtomError> {
-        let id = self.id(index)?;
-        let op = Op::Read {
-            id,
-            addr,
-            count: if two_bytes { 2 } else { 1 },
-        };
-        if self
-            .bank
-            .queue_op(op, Then::ReplyServoData { link, two_bytes })
-        {
-            Ok(())
-        } else {
-            Err(AtomError::Busy)
-        }
+/// Calibration (0x54, 0x68): the servo's present position becomes 2048. A joint's motion is
+/// halted first; the gripper's range follows its calibration.
+pub fn calibrate(
+    cx: &mut Context<'_>,
+    motion: &mut MotionController,
+    gripper: &mut Gripper,
+    index: usize,
+) -> Result<(), AtomError> {
+    let id = id(cx.settings, index)?;
+    if index < JOINTS {
+        motion.halt(cx);
     }
+    let op = Op::write(id, reg::TORQUE_ENABLE, &[128]).ok_or(AtomError::Invalid)?;
+    if !cx.bank.queue_op(op) {
+        return Err(AtomError::Busy);
+    }
+    cx.bank.calibrated(index);
+    if index == GRIPPER {
+        gripper.calibrated();
+    }
+    Ok(())
+}
 
-    /// Calibration (0x54, 0x68): the servo's present position becomes 2048. A joint's motion
-    /// is halted first.
-    pub fn calibrate(&mut self, now_us: u64, index: usize) -> Result<(), AtomError> {
-        let id = self.id(index)?;
-        if index < JOINTS {
-            self.motion.halt(now_us, self.bank, self.settings);
-        }
-        let op = Op::write(id, reg::TORQUE_ENABLE, &[128]).ok_or(AtomError::Invalid)?;
-        if !self.bank.queue_op(op, Then::Nothing) {
-            return Err(AtomError::Busy);
-        }
-        self.bank.calibrated(index);
-        if index == GRIPPER {
-            self.gripper.calibrated();
-        }
-        Ok(())
-    }
+/// Joint brake (0x55): the servo holds where it is.
+pub fn brake(cx: &mut Context<'_>, index: usize) -> Result<(), AtomError> {
+    let steps = cx
+        .bank
+        .health(index)
+        .map(|h| h.position)
+        .ok_or(AtomError::Invalid)?;
+    move_to_steps(cx, index, steps)
+}
 
-    /// Joint brake (0x55): the servo holds where it is.
-    pub fn brake(&mut self, index: usize) -> Result<(), AtomError> {
-        let steps = self
-            .bank
-            .health(index)
-            .map(|h| h.position)
-            .ok_or(AtomError::Invalid)?;
-        self.move_to_steps(index, steps)
+/// Moves servo `index` to an encoder position at the default speed.
+fn move_to_steps(cx: &mut Context<'_>, index: usize, steps: Steps) -> Result<(), AtomError> {
+    let speed = cx.settings.speed_percent();
+    if index == GRIPPER {
+        return gripper::move_steps(cx, steps, speed);
     }
+    let config = cx.settings.config();
+    let goal = Goal {
+        position: steps,
+        speed_steps_per_s: config.joint_speed_steps(speed) as u16,
+        accel: config.joint_accel_register(),
+    };
+    cx.send_goals(Goals::one(index, goal))
+}
 
-    /// Moves servo `index` to an encoder position at the default speed.
-    fn move_to_steps(&mut self, index: usize, steps: Steps) -> Result<(), AtomError> {
-        let speed = self.settings.speed_percent();
-        if index == GRIPPER {
-            return gripper::move_steps(self.bank, self.settings, steps, speed);
-        }
-        let config = self.settings.config();
-        let mut goals: GoalSet = [None; SERVOS];
-        if let Some(slot) = goals.get_mut(index) {
-            *slot = Some(Goal {
-                position: steps,
-                speed_steps_per_s: config.joint_speed_steps(speed) as u16,
-                accel: config.joint_accel_register(),
-            });
-        }
-        self.bank.send_goals(self.settings, goals)
-    }
-
-    fn id(&self, index: usize) -> Result<u8, AtomError> {
-        self.settings
-            .config()
-            .servo_ids
-            .get(index)
-            .copied()
-            .ok_or(AtomError::Invalid)
-    }
+/// The bus id of servo `index`.
+fn id(settings: &Settings, index: usize) -> Result<u8, AtomError> {
+    settings
+        .config()
+        .servo_ids
+        .get(index)
+        .copied()
+        .ok_or(AtomError::Invalid)
 }
 
 /// Fastest goal speed a drag (0x3E) may ask for, steps per second: the STS3215's top speed.
@@ -212,8 +186,7 @@ pub const MAX_DRAG_SPEED_STEPS_PER_S: i16 = 3_400;
 /// A speed of 0 (the servo would read it as "as fast as you can"), a negative one or one above
 /// [`MAX_DRAG_SPEED_STEPS_PER_S`] is refused: nothing creeps and nothing races.
 pub fn drag_to(
-    bank: &mut ServoBank,
-    settings: &Settings,
+    cx: &mut Context<'_>,
     encoders: [Steps; JOINTS],
     speeds_steps_per_s: [i16; JOINTS],
 ) -> Result<(), AtomError> {
@@ -223,19 +196,17 @@ pub fn drag_to(
     {
         return Err(AtomError::Invalid);
     }
-    let accel = settings.config().joint_accel_register();
-    let mut goals: GoalSet = [None; SERVOS];
-    for (slot, (e, s)) in goals
-        .iter_mut()
-        .zip(encoders.iter().zip(speeds_steps_per_s))
-    {
-        *slot = Some(Goal {
+    let accel = cx.settings.config().joint_accel_register();
+    let mut goals = Goals::NONE;
+    for (j, (e, s)) in encoders.iter().zip(speeds_steps_per_s).enumerate() {
+        let goal = Goal {
             position: *e,
             speed_steps_per_s: s.unsigned_abs(),
             accel,
-        });
+        };
+        goals.set(j, Some(goal));
     }
-    bank.send_goals(settings, goals)
+    cx.send_goals(goals)
 }
 
 #[cfg(test)]

@@ -224,3 +224,89 @@ impl BusSchedule {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::at_rest;
+    use crate::safety::{Goal, Goals};
+    use protocol_core::servo::{BROADCAST_ID, reg};
+    use protocol_core::units::Steps;
+
+    /// A bus where nobody answers; keeps what the Atom wrote.
+    #[derive(Default)]
+    struct Wire {
+        written: std::vec::Vec<std::vec::Vec<u8>>,
+    }
+
+    impl BytePort for Wire {
+        fn read_byte(&mut self) -> Option<u8> {
+            None
+        }
+        fn write(&mut self, bytes: &[u8]) {
+            self.written.push(bytes.to_vec());
+        }
+        fn tx_idle(&self) -> bool {
+            true
+        }
+    }
+
+    /// Servo id and instruction of each servo packet written.
+    fn instructions(wire: &Wire) -> std::vec::Vec<(u8, u8)> {
+        wire.written.iter().map(|p| (p[2], p[4])).collect()
+    }
+
+    const READ: u8 = 2;
+    const WRITE: u8 = 3;
+    const SYNC_WRITE: u8 = 0x83;
+
+    #[test]
+    fn host_operations_goals_and_the_refresh_take_turns() {
+        let (settings, mut bank) = at_rest();
+        let mut schedule = BusSchedule::new(settings.config().timing.reply_margin_us);
+        let mut wire = Wire::default();
+        for _ in 0..2 {
+            let op = Op::write(1, reg::ACCELERATION, &[5]).unwrap();
+            assert!(bank.queue_op(op));
+        }
+        let goal = Goal {
+            position: Steps(2_100),
+            speed_steps_per_s: 100,
+            accel: 10,
+        };
+        bank.send_goals(0, &settings, Goals::one(0, goal)).unwrap();
+        let mut now = 10_000;
+        for _ in 0..8 {
+            schedule.start_next(now, &mut wire, &mut bank, &settings);
+            now += 10_000;
+            if let Some((op, outcome)) = schedule.poll_driver(now, &wire) {
+                bank.finish(now, &settings, op, outcome, false);
+            }
+        }
+        assert_eq!(
+            instructions(&wire),
+            [
+                (1, WRITE),
+                (1, READ),
+                (1, WRITE),
+                (2, READ),
+                (BROADCAST_ID, SYNC_WRITE),
+                (3, READ),
+                (4, READ),
+                (5, READ),
+            ],
+            "after each host operation or goal write one refresh read, then the refresh alone"
+        );
+    }
+
+    #[test]
+    fn a_reply_goes_out_before_the_next_transaction() {
+        let (settings, mut bank) = at_rest();
+        let mut schedule = BusSchedule::new(settings.config().timing.reply_margin_us);
+        let mut wire = Wire::default();
+        let reply = Frame::new(0x20, &[1]).unwrap();
+        schedule.send_reply(reply.clone());
+        schedule.start_next(10_000, &mut wire, &mut bank, &settings);
+        assert_eq!(wire.written, [reply.to_bytes().to_vec()]);
+    }
+}

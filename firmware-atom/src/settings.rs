@@ -1,6 +1,10 @@
 //! What the host has set: joint limits, fresh/free mode, the default speed and the coordinate
-//! frames. Every setter validates; nothing else changes these values.
+//! frames. The fields are private and every setter keeps what depends on them in step: a new
+//! limit is checked against the factory range and handed to the kinematics' branch selection,
+//! a new frame is re-applied to the kinematics model. Values the protocol layer has already
+//! range-checked (speed, modes) are taken as they come.
 
+use protocol_core::command::{EndType, MoveMode, Pose, ReferenceFrame};
 use protocol_core::units::{Centideg, Decideg, Steps};
 
 use crate::cartesian::Cartesian;
@@ -143,9 +147,29 @@ impl Settings {
         &self.cart
     }
 
-    /// The kinematics with the selected frames, for changing the frames or caching FK.
-    pub fn cart_mut(&mut self) -> &mut Cartesian {
-        &mut self.cart
+    /// Sets the tool pose (0x81), re-applying the frames.
+    pub fn set_tool(&mut self, pose: Pose) {
+        self.cart.set_tool(pose);
+    }
+
+    /// Sets the base pose in the world frame (0x83), re-applying the frames.
+    pub fn set_world(&mut self, pose: Pose) {
+        self.cart.set_world(pose);
+    }
+
+    /// Sets the reference frame (0x85), re-applying the frames.
+    pub fn set_reference(&mut self, frame: ReferenceFrame) {
+        self.cart.set_reference(frame);
+    }
+
+    /// Sets the end type (0x89), re-applying the frames.
+    pub fn set_end(&mut self, end: EndType) {
+        self.cart.set_end(end);
+    }
+
+    /// Sets the default interpolation of send coords (0x87).
+    pub fn set_movement(&mut self, mode: MoveMode) {
+        self.cart.set_movement(mode);
     }
 }
 

@@ -3,12 +3,12 @@
 use protocol_core::servo::{Packet, reg, sign_magnitude};
 use protocol_core::units::Steps;
 
-use super::{ServoBank, Then};
-use crate::config::SERVOS;
+use super::ServoBank;
 use crate::driver::Op;
 use crate::health::ServoHealth;
-use crate::safety::{self, GoalSet};
+use crate::safety::Goals;
 use crate::settings::Settings;
+use crate::tolerance;
 
 /// First register of the state read: torque enable (40) through present current (69..70), so
 /// one READ per servo confirms torque and goal as well as the present state. 31 bytes: a
@@ -20,7 +20,7 @@ pub(super) const STATE_READ_LEN: u8 = reg::PRESENT_CURRENT + 2 - reg::TORQUE_ENA
 /// Corrective writes per servo and command when the read-back disagrees (a lost write is
 /// re-sent; a servo that keeps disagreeing, e.g. a goal clamped by its own position limits, is
 /// left alone after this many).
-const MAX_REPAIRS: u8 = 3;
+pub(super) const MAX_REPAIRS: u8 = 3;
 
 /// Applies a state read (registers 40..=70) to a servo's health.
 pub(super) fn apply_state(h: &mut ServoHealth, p: &Packet) {
@@ -52,16 +52,16 @@ impl ServoBank {
         let Some(&id) = settings.config().servo_ids.get(index) else {
             return;
         };
-        let Some(h) = self.health.get(index).copied() else {
+        let Some(s) = self.servos.get(index).copied() else {
             return;
         };
+        let h = s.health;
         let pending_goal = self
             .pending
             .as_ref()
-            .is_some_and(|p| p.goals().get(index).copied().flatten().is_some());
+            .is_some_and(|p| p.goals().get(index).is_some());
         let pending_job = self.jobs.iter().any(|j| j.op.id() == id);
-        let repairs = self.repairs.get(index).copied().unwrap_or(MAX_REPAIRS);
-        if pending_goal || pending_job || repairs >= MAX_REPAIRS {
+        if pending_goal || pending_job || s.repairs >= MAX_REPAIRS {
             return;
         }
         if h.torque_reported != h.torque_on {
@@ -71,30 +71,25 @@ impl ServoBank {
                 Op::write(id, reg::TORQUE_ENABLE, &[0])
             };
             if let Some(op) = op {
-                self.queue_op(op, Then::Nothing);
+                self.queue_op(op);
             }
         } else if h.torque_on
-            && let Some(goal) = self.last_goal.get(index).copied().flatten()
-            && (i32::from(goal.position.0) - i32::from(h.goal_reported.0)).abs() > 1
+            && let Some(goal) = s.last_goal
+            && !tolerance::goal_confirmed(goal.position, h.goal_reported)
         {
-            let mut merged: GoalSet = self
-                .pending
-                .as_ref()
-                .map(|p| *p.goals())
-                .unwrap_or([None; SERVOS]);
-            if let Some(slot) = merged.get_mut(index) {
-                *slot = Some(goal);
-            }
+            let waiting = self.pending.as_ref().map_or(Goals::NONE, |p| *p.goals());
             // Through the safety check again: the limits may have changed since.
-            match safety::check(settings.config(), settings.limits(), self.powered, merged) {
-                Ok(safe) => self.pending = Some(safe),
-                Err(_) => return,
+            if self
+                .hold_pending(settings, waiting.merge(&Goals::one(index, goal)))
+                .is_err()
+            {
+                return;
             }
         } else {
             return;
         }
-        if let Some(r) = self.repairs.get_mut(index) {
-            *r += 1;
+        if let Some(s) = self.servos.get_mut(index) {
+            s.repairs += 1;
         }
     }
 }

@@ -3,10 +3,9 @@
 
 use protocol_core::units::{Centideg, Steps};
 
-use crate::bank::ServoBank;
-use crate::config::{JOINTS, SERVOS, STEPS_PER_TURN};
-use crate::safety::{Goal, GoalSet};
-use crate::settings::Settings;
+use crate::config::{JOINTS, STEPS_PER_TURN};
+use crate::context::Context;
+use crate::safety::{Goal, Goals};
 
 /// Time from computing a goal to the servo acting on it, in microseconds: a transaction may be
 /// on the wire (up to about 0.6 ms), then the gap and the SYNC WRITE itself (about 0.7 ms).
@@ -21,7 +20,7 @@ const SETTLE_SPEED_STEPS_PER_S: u64 = 50;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Braking {
     /// The stopping goal of each joint that holds torque.
-    pub goals: [Option<Goal>; JOINTS],
+    pub goals: Goals,
     /// Where each joint comes to rest (its present angle if it holds no torque).
     pub rest: [Centideg; JOINTS],
     /// Time from now until every joint is at rest, microseconds.
@@ -41,17 +40,19 @@ impl Braking {
     /// ([`GOAL_LATENCY_US`]) and while braking (`v_j * T / 2`). A stop is kept within the
     /// joint's limits, but a joint already past a limit (the user just tightened it) stays
     /// where it is rather than being dragged back.
-    pub fn of(bank: &ServoBank, settings: &Settings) -> Self {
+    pub fn of(cx: &Context<'_>) -> Self {
+        let (bank, settings, now_us) = (&*cx.bank, cx.settings, cx.now_us);
         let config = settings.config();
         let a = i64::from(config.motion.servo_accel_steps_per_s2.max(1));
         let v_max = (0..JOINTS)
-            .map(|j| i64::from(bank.last_known_velocity(j)).abs())
+            .map(|j| i64::from(bank.last_known_velocity(now_us, j)).abs())
             .max()
             .unwrap_or(0);
         let brake_us = v_max * 1_000_000 / a;
-        let mut goals = [None; JOINTS];
-        let present: [Centideg; JOINTS] =
-            core::array::from_fn(|j| config.millisteps_to_angle(j, bank.last_known_millisteps(j)));
+        let mut goals = Goals::NONE;
+        let present: [Centideg; JOINTS] = core::array::from_fn(|j| {
+            config.millisteps_to_angle(j, bank.last_known_millisteps(now_us, j))
+        });
         let mut rest = present;
         for j in 0..JOINTS {
             // Every joint that holds torque, including one whose latest reads were lost: it
@@ -59,8 +60,8 @@ impl Braking {
             if !bank.holds_torque(j) {
                 continue;
             }
-            let v = i64::from(bank.last_known_velocity(j));
-            let stop = rest_steps(bank, j, brake_us);
+            let v = i64::from(bank.last_known_velocity(now_us, j));
+            let stop = rest_steps(cx, j, brake_us);
             let now = present.get(j).copied().unwrap_or_default();
             let mut angle = settings.angle(j, stop);
             if let Some(limit) = settings.limit(j) {
@@ -71,16 +72,15 @@ impl Braking {
             } else {
                 ((a * v.abs() + v_max * 100 - 1) / (v_max * 100)).clamp(1, 254) as u8
             };
-            if let Some(slot) = goals.get_mut(j) {
-                *slot = Some(Goal {
-                    position: settings.goal_steps(j, angle),
-                    speed_steps_per_s: v
-                        .unsigned_abs()
-                        .clamp(SETTLE_SPEED_STEPS_PER_S, u64::from(u16::MAX))
-                        as u16,
-                    accel,
-                });
-            }
+            let goal = Goal {
+                position: settings.goal_steps(j, angle),
+                speed_steps_per_s: v
+                    .unsigned_abs()
+                    .clamp(SETTLE_SPEED_STEPS_PER_S, u64::from(u16::MAX))
+                    as u16,
+                accel,
+            };
+            goals.set(j, Some(goal));
             if let Some(r) = rest.get_mut(j) {
                 *r = angle;
             }
@@ -95,13 +95,9 @@ impl Braking {
     /// Sends the stop, one joint at a time: a joint whose stop the safety check refuses (it
     /// stands outside its limits after being moved by hand) keeps its previous goal, and the
     /// others still stop.
-    pub fn send(&self, bank: &mut ServoBank, settings: &Settings) {
-        for (j, goal) in self.goals.iter().enumerate() {
-            let mut one: GoalSet = [None; SERVOS];
-            if let (Some(slot), Some(g)) = (one.get_mut(j), goal) {
-                *slot = Some(*g);
-                let _ = bank.send_goals(settings, one);
-            }
+    pub fn send(&self, cx: &mut Context<'_>) {
+        for (j, goal) in self.goals.iter() {
+            let _ = cx.send_goals(Goals::one(j, goal));
         }
     }
 }
@@ -109,28 +105,72 @@ impl Braking {
 /// Where servo `index` comes to rest when it brakes for `brake_us`, decelerating evenly from
 /// its last read speed: its estimated present position, plus what it covers until the goal
 /// arrives ([`GOAL_LATENCY_US`]) and while braking (`v * brake / 2`).
-fn rest_steps(bank: &ServoBank, index: usize, brake_us: i64) -> Steps {
-    let v = i64::from(bank.last_known_velocity(index));
+fn rest_steps(cx: &Context<'_>, index: usize, brake_us: i64) -> Steps {
+    let v = i64::from(cx.bank.last_known_velocity(cx.now_us, index));
     let travel_millisteps = v * (GOAL_LATENCY_US as i64 + brake_us / 2) / 1000;
-    let stop = (bank.last_known_millisteps(index) + travel_millisteps + 500).div_euclid(1000);
+    let at = cx.bank.last_known_millisteps(cx.now_us, index);
+    let stop = (at + travel_millisteps + 500).div_euclid(1000);
     Steps(stop.clamp(0, i64::from(STEPS_PER_TURN) - 1) as i16)
 }
 
 /// The goal that stops servo `index` (the gripper, or one joint on its own) at the servos' full
 /// deceleration, where it comes to rest; `None` if it holds no torque.
-pub fn stop_one(bank: &ServoBank, settings: &Settings, index: usize) -> Option<Goal> {
-    if !bank.holds_torque(index) {
+pub fn stop_one(cx: &Context<'_>, index: usize) -> Option<Goal> {
+    if !cx.bank.holds_torque(index) {
         return None;
     }
-    let config = settings.config();
+    let config = cx.settings.config();
     let a = i64::from(config.motion.servo_accel_steps_per_s2.max(1));
-    let v = i64::from(bank.last_known_velocity(index));
+    let v = i64::from(cx.bank.last_known_velocity(cx.now_us, index));
     let brake_us = v.abs() * 1_000_000 / a;
     Some(Goal {
-        position: rest_steps(bank, index, brake_us),
+        position: rest_steps(cx, index, brake_us),
         speed_steps_per_s: v
             .unsigned_abs()
             .clamp(SETTLE_SPEED_STEPS_PER_S, u64::from(u16::MAX)) as u16,
         accel: config.servo_accel_register(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::{bank_read, powered};
+
+    #[test]
+    fn every_joint_brakes_in_proportion_to_its_speed_so_all_stop_together() {
+        let settings = powered();
+        let config = settings.config();
+        let mut bank = bank_read(&settings, 0, [2_048; JOINTS], [2_000, 1_000, -500, 0, 0, 0]);
+        let cx = Context::new(0, &mut bank, &settings);
+        let stop = Braking::of(&cx);
+        let a = i64::from(config.motion.servo_accel_steps_per_s2);
+        let brake_us = 2_000 * 1_000_000 / a;
+        assert_eq!(stop.duration_us, GOAL_LATENCY_US + brake_us as u64);
+        let goal = |j: usize| stop.goals.get(j).unwrap();
+        // The fastest joint at full deceleration, the others at their share of it.
+        assert_eq!(i64::from(goal(0).accel), (a + 99) / 100);
+        assert_eq!(i64::from(goal(1).accel), (a / 2 + 99) / 100);
+        assert_eq!(i64::from(goal(2).accel), (a / 4 + 99) / 100);
+        // Each comes to rest where its speed carries it: latency plus half the braking time.
+        for (j, v) in [(0, 2_000), (1, 1_000), (2, -500)] {
+            let travel = v * (GOAL_LATENCY_US as i64 + brake_us / 2) / 1_000;
+            let rest = (2_048_000 + travel + 500).div_euclid(1_000);
+            assert_eq!(i64::from(goal(j).position.0), rest, "joint {}", j + 1);
+            assert_eq!(stop.rest[j], settings.angle(j, Steps(rest as i16)));
+        }
+        assert_eq!(goal(3).position, Steps(2_048), "a joint at rest stays");
+        assert_eq!(goal(3).speed_steps_per_s, 50, "and settles at once");
+    }
+
+    #[test]
+    fn a_lone_servo_stops_at_full_deceleration() {
+        let settings = powered();
+        let mut bank = bank_read(&settings, 0, [2_048; JOINTS], [0, 0, 0, 0, 1_140, 0]);
+        let cx = Context::new(0, &mut bank, &settings);
+        let g = stop_one(&cx, 4).unwrap();
+        assert_eq!(g.accel, settings.config().servo_accel_register());
+        assert_eq!(g.speed_steps_per_s, 1_140);
+        assert!(g.position.0 > 2_048 + 50, "{g:?}");
+    }
 }

@@ -10,9 +10,9 @@
 
 use protocol_core::units::{Centideg, Steps};
 
-use crate::bank::ServoBank;
-use crate::config::{JOINTS, SERVOS, STEPS_PER_TURN};
-use crate::safety::{Goal, GoalSet};
+use crate::config::{JOINTS, STEPS_PER_TURN};
+use crate::context::Context;
+use crate::safety::{Goal, Goals};
 use crate::settings::Settings;
 
 /// How much of the difference between where a joint was expected to be and where its state
@@ -39,6 +39,21 @@ pub enum Pace {
     Together,
 }
 
+/// One target of a sequence and how to get there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Leg {
+    /// The joint angles to pass.
+    pub target: [Centideg; JOINTS],
+    /// Time until the next target is due, microseconds.
+    pub period_us: u64,
+    /// No joint faster than this, steps per second.
+    pub speed_cap_steps_per_s: u32,
+    /// How the joints change speed.
+    pub pace: Pace,
+    /// The sequence ends here: stop at `target`.
+    pub last: bool,
+}
+
 /// Follows a sequence of targets. See the [module doc](self).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Follower {
@@ -48,20 +63,17 @@ pub struct Follower {
 }
 
 impl Follower {
-    /// The goals that carry the joints to `target` in `period_us` and on (see the
-    /// [module doc](self)), no joint faster than `speed_cap_steps_per_s`. `last`: the sequence
-    /// ends here, stop at `target`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn goals_towards(
-        &mut self,
-        bank: &ServoBank,
-        settings: &Settings,
-        target: &[Centideg; JOINTS],
-        period_us: u64,
-        speed_cap_steps_per_s: u32,
-        pace: Pace,
-        last: bool,
-    ) -> GoalSet {
+    /// The goals that carry the joints to `leg`'s target in its period and on (see the
+    /// [module doc](self)), from where the joints are at the step's time.
+    pub fn goals_towards(&mut self, cx: &Context<'_>, leg: &Leg) -> Goals {
+        let (bank, settings) = (&*cx.bank, cx.settings);
+        let Leg {
+            target,
+            period_us,
+            speed_cap_steps_per_s,
+            pace,
+            last,
+        } = *leg;
         let config = settings.config();
         let full = i64::from(config.motion.servo_accel_steps_per_s2.max(100));
         let period = period_us.max(1) as i64;
@@ -79,7 +91,7 @@ impl Follower {
             }
         });
         let from: [i64; JOINTS] = core::array::from_fn(|j| {
-            let measured = bank.estimated_millisteps(j);
+            let measured = bank.estimated_millisteps(cx.now_us, j);
             match &self.last {
                 Some((expected, _)) if !last => {
                     let e = expected.get(j).copied().unwrap_or(measured);
@@ -117,9 +129,9 @@ impl Follower {
             .max()
             .unwrap_or(0);
         let together_us = (largest * 1_000_000 / full).max(1_000);
-        let mut goals: GoalSet = [None; SERVOS];
+        let mut goals = Goals::NONE;
         let mut expected = to;
-        for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
+        for j in 0..JOINTS {
             if !answering.get(j).copied().unwrap_or(false) {
                 continue;
             }
@@ -149,11 +161,12 @@ impl Follower {
                 *e = f + speed.signum() * i64::from(speed_register) * period / 1000;
             }
             let t = to.get(j).copied().unwrap_or(f);
-            *slot = Some(Goal {
+            let goal = Goal {
                 position: goal_position(settings, j, t + beyond),
                 speed_steps_per_s: speed_register,
                 accel: accel_register,
-            });
+            };
+            goals.set(j, Some(goal));
         }
         self.last = Some((expected, speeds));
         goals
@@ -170,4 +183,83 @@ fn goal_position(settings: &Settings, j: usize, millisteps: i64) -> Steps {
         angle = angle.clamp(limit.min, limit.max);
     }
     settings.goal_steps(j, angle)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::at_rest;
+
+    const PERIOD_US: u64 = 20_000;
+
+    fn leg(target: [Centideg; JOINTS], last: bool) -> Leg {
+        Leg {
+            target,
+            period_us: PERIOD_US,
+            speed_cap_steps_per_s: 3_000,
+            pace: Pace::Free,
+            last,
+        }
+    }
+
+    #[test]
+    fn a_joint_gets_the_speed_to_its_target_and_a_goal_a_braking_distance_beyond() {
+        let (settings, mut bank) = at_rest();
+        let config = settings.config();
+        let cx = Context::new(0, &mut bank, &settings);
+        let mut target = [Centideg(0); JOINTS];
+        target[0] = settings.angle(0, Steps(2_068));
+        let goals = Follower::default().goals_towards(&cx, &leg(target, false));
+        let to = config.angle_to_millisteps(0, i32::from(target[0].0));
+        let speed = (to - 2_048_000) * 1000 / PERIOD_US as i64;
+        let g = goals.get(0).unwrap();
+        assert_eq!(i64::from(g.speed_steps_per_s), speed, "there in one period");
+        assert_eq!(
+            g.accel,
+            config.servo_accel_register(),
+            "free pace: full acceleration"
+        );
+        let braking = speed * speed * 1000 / (2 * i64::from(g.accel) * 100);
+        assert!(
+            i64::from(g.position.0) * 1000 >= to + braking,
+            "the goal lies beyond the target by at least the braking distance: {g:?}"
+        );
+        assert_eq!(
+            goals.get(1).unwrap().position,
+            Steps(2_048),
+            "a joint that stays"
+        );
+    }
+
+    #[test]
+    fn the_next_target_starts_from_where_the_joint_should_be_and_the_last_is_the_goal() {
+        let (settings, mut bank) = at_rest();
+        let cx = Context::new(0, &mut bank, &settings);
+        let mut follower = Follower::default();
+        let mut target = [Centideg(0); JOINTS];
+        target[0] = settings.angle(0, Steps(2_068));
+        let first = follower
+            .goals_towards(&cx, &leg(target, false))
+            .get(0)
+            .unwrap();
+        // The read still says 2048 (a few ms old): the follower expects the joint 20 steps on
+        // and asks for the next 20 steps, not for 40.
+        target[0] = settings.angle(0, Steps(2_088));
+        let second = follower
+            .goals_towards(&cx, &leg(target, false))
+            .get(0)
+            .unwrap();
+        let diff = i32::from(second.speed_steps_per_s) - i32::from(first.speed_steps_per_s);
+        assert!(diff.abs() < 300, "{first:?} then {second:?}");
+        let last = follower
+            .goals_towards(&cx, &leg(target, true))
+            .get(0)
+            .unwrap();
+        assert_eq!(
+            last.position,
+            Steps(2_088),
+            "the last target is the goal itself"
+        );
+        assert!(last.speed_steps_per_s >= 50);
+    }
 }

@@ -25,19 +25,20 @@ pub mod plan;
 mod stream;
 
 use heapless::Deque;
-use protocol_core::command::Pose;
+use protocol_core::command::{MoveMode, Pose};
 use protocol_core::units::Centideg;
 
 use crate::bank::ServoBank;
 use crate::config::JOINTS;
+use crate::context::Context;
 use crate::error::AtomError;
-use crate::settings::Settings;
+use crate::tolerance;
 use brake::Braking;
 pub use brake::stop_one;
-use follow::{Follower, Pace};
+use follow::{Follower, Leg, Pace};
 pub use path::plan_arc;
 use path::{PathRunner, Step};
-pub use plan::{IN_POSITION_CENTIDEG, MOVE_OVERTIME_US, angles_match};
+pub use plan::MOVE_OVERTIME_US;
 pub use stream::STREAM_GAP_MAX_US;
 use stream::{StreamClock, stream_ended};
 
@@ -104,11 +105,63 @@ impl Target {
             way: Way::Joints,
         }
     }
+
+    /// A joint-interpolated move of joint `j` alone to `angle`.
+    pub fn joint(j: usize, angle: Centideg, speed_percent: u8) -> Self {
+        let mut angles = [None; JOINTS];
+        if let Some(slot) = angles.get_mut(j) {
+            *slot = Some(angle);
+        }
+        Self::joints(angles, speed_percent)
+    }
 }
 
-/// Distance within which the arm counts as already at the start of an arc (0x8B), so no line
-/// leads to it: 0.5 mm (5 wire units) and 0.5 deg (50).
-const AT_ARC_START: (i32, i32) = (5, 50);
+/// What the host asks the arm to do: every new motion enters through
+/// [`MotionController::command`], the one place that checks the arm is powered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Command {
+    /// A move to joint angles (send angles, encoders, increments).
+    Move(Target),
+    /// A move of the end to `pose`: joint-interpolated or along a straight line (`mode`).
+    ToPose {
+        /// Where the end goes.
+        pose: Pose,
+        /// Speed, percent.
+        speed_percent: u8,
+        /// Joint interpolation (0) or a straight line (1).
+        mode: MoveMode,
+    },
+    /// A circular arc through `via` to `end`, from `begin` (reached first along a line) or
+    /// from where the arm is (0x8B, 0x8C).
+    Arc {
+        /// Where the arc starts; `None`: where the arm is.
+        begin: Option<Pose>,
+        /// A pose the arc passes through.
+        via: Pose,
+        /// Where the arc ends.
+        end: Pose,
+        /// Speed, percent.
+        speed_percent: u8,
+    },
+    /// A continuous jog of joint `joint` (0-based) toward its limit.
+    JogJoint {
+        /// The joint, 0-based.
+        joint: usize,
+        /// Toward which limit.
+        direction: JogDirection,
+        /// Speed, percent.
+        speed_percent: u8,
+    },
+    /// A continuous Cartesian jog: `axis` 0..2 along x, y, z, 3..5 about the base x, y, z.
+    JogPose {
+        /// The axis.
+        axis: usize,
+        /// Which way.
+        direction: JogDirection,
+        /// Speed, percent.
+        speed_percent: u8,
+    },
+}
 
 /// A continuous jog.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -206,22 +259,43 @@ impl MotionController {
         self.last_host_cmd_us = now_us;
     }
 
+    /// Accepts a new motion: refused while the arm is powered off (the one power check of
+    /// every motion), then each kind of motion checks its own rules.
+    pub fn command(&mut self, cx: &mut Context<'_>, command: Command) -> Result<(), AtomError> {
+        cx.require_power()?;
+        match command {
+            Command::Move(target) => self.submit(cx, target),
+            Command::ToPose {
+                pose,
+                speed_percent,
+                mode,
+            } => self.move_to_pose(cx, pose, speed_percent, mode),
+            Command::Arc {
+                begin,
+                via,
+                end,
+                speed_percent,
+            } => self.submit_arc(cx, begin, via, end, speed_percent),
+            Command::JogJoint {
+                joint,
+                direction,
+                speed_percent,
+            } => self.jog_joint(cx, joint, direction, speed_percent),
+            Command::JogPose {
+                axis,
+                direction,
+                speed_percent,
+            } => self.jog_pose(cx, axis, direction, speed_percent),
+        }
+    }
+
     /// Accepts a move: in fresh mode it starts now (following a stream, or replacing the
     /// current motion after braking), in queue mode it waits for the moves before it.
-    pub fn submit(
-        &mut self,
-        now_us: u64,
-        target: Target,
-        bank: &mut ServoBank,
-        settings: &Settings,
-    ) -> Result<(), AtomError> {
-        check(bank, settings, &target)?;
-        if !settings.fresh_mode() {
-            return if matches!(self.activity, Activity::Idle)
-                && self.queue.is_empty()
-                && self.paused.is_none()
-            {
-                self.start(now_us, Order::Move(target), bank, settings)
+    fn submit(&mut self, cx: &mut Context<'_>, target: Target) -> Result<(), AtomError> {
+        cx.settings.check_angles(&target.angles)?;
+        if !cx.settings.fresh_mode() {
+            return if self.idle_with_nothing_waiting() {
+                self.start(cx, Order::Move(target))
             } else {
                 self.queue.push_back(target).map_err(|_| AtomError::Busy)
             };
@@ -230,37 +304,52 @@ impl MotionController {
         self.paused = None;
         let full = full_angles(&target.angles);
         let period = match full {
-            Some(_) => self.clock.arrival(now_us),
+            Some(_) => self.clock.arrival(cx.now_us),
             None => {
                 self.clock.reset();
                 None
             }
         };
         match (full, period) {
-            (Some(angles), Some(period_us)) => self.follow_stream(
-                now_us,
-                angles,
-                target.speed_percent,
-                period_us,
-                bank,
-                settings,
-            ),
-            _ => self.replace(now_us, Order::Move(target), bank, settings),
+            (Some(angles), Some(period_us)) => {
+                self.follow_stream(cx, angles, target.speed_percent, period_us)
+            }
+            _ => self.replace(cx, Order::Move(target)),
         }
+    }
+
+    /// Moves the end to `pose`: joint-interpolated (mode 0) or along a straight line (mode 1),
+    /// the joint angles solved from where the arm is going.
+    fn move_to_pose(
+        &mut self,
+        cx: &mut Context<'_>,
+        pose: Pose,
+        speed_percent: u8,
+        mode: MoveMode,
+    ) -> Result<(), AtomError> {
+        let seed = self.planned_angles(cx);
+        let angles = cx.settings.cart().inverse(&pose, &seed)?;
+        let target = Target {
+            angles: angles.map(Some),
+            speed_percent,
+            way: match mode {
+                MoveMode::Linear => Way::Line(pose),
+                MoveMode::Joint => Way::Joints,
+            },
+        };
+        self.submit(cx, target)
     }
 
     /// Starts a continuous jog of joint `j` toward its limit. The same jog again only changes
     /// its speed; another motion is braked first.
-    pub fn jog_joint(
+    fn jog_joint(
         &mut self,
-        now_us: u64,
+        cx: &mut Context<'_>,
         j: usize,
         direction: JogDirection,
         speed_percent: u8,
-        bank: &mut ServoBank,
-        settings: &Settings,
     ) -> Result<(), AtomError> {
-        let end = jog_end(bank, settings, j, direction)?;
+        let end = jog_end(cx, j, direction)?;
         let jog = Jog::Joint {
             joint: j,
             direction,
@@ -271,36 +360,22 @@ impl MotionController {
         } = self.activity
             && running == jog
         {
-            let mut angles = [None; JOINTS];
-            if let Some(slot) = angles.get_mut(j) {
-                *slot = Some(end);
-            }
-            return self.start_joint_move(
-                now_us,
-                Target::joints(angles, speed_percent),
-                Some(jog),
-                bank,
-                settings,
-            );
+            let target = Target::joint(j, end, speed_percent);
+            return self.start_joint_move(cx, target, Some(jog));
         }
-        self.replace(now_us, Order::Jog { jog, speed_percent }, bank, settings)
+        self.replace(cx, Order::Jog { jog, speed_percent })
     }
 
     /// Starts a continuous Cartesian jog: `axis` 0..2 along x, y, z, 3..5 about the base x, y,
     /// z axes. The same jog at the same speed again changes nothing; another motion is braked
     /// first.
-    pub fn jog_pose(
+    fn jog_pose(
         &mut self,
-        now_us: u64,
+        cx: &mut Context<'_>,
         axis: usize,
         direction: JogDirection,
         speed_percent: u8,
-        bank: &mut ServoBank,
-        settings: &Settings,
     ) -> Result<(), AtomError> {
-        if !bank.powered() {
-            return Err(AtomError::PoweredOff);
-        }
         let jog = Jog::Pose { axis, direction };
         self.forget_plans();
         if let Activity::Path {
@@ -313,18 +388,18 @@ impl MotionController {
         {
             return Ok(());
         }
-        self.replace(now_us, Order::Jog { jog, speed_percent }, bank, settings)
+        self.replace(cx, Order::Jog { jog, speed_percent })
     }
 
     /// Stops the arm (0x29, 0x34 jog stop): brakes every joint and forgets queued and paused
     /// moves.
-    pub fn stop(&mut self, now_us: u64, bank: &mut ServoBank, settings: &Settings) {
+    pub fn stop(&mut self, cx: &mut Context<'_>) {
         self.forget_plans();
-        self.brake(now_us, None, bank, settings);
+        self.brake(cx, None);
     }
 
     /// Pauses the current move (0x26): brakes, and remembers the move for [`Self::resume`].
-    pub fn pause(&mut self, now_us: u64, bank: &mut ServoBank, settings: &Settings) {
+    pub fn pause(&mut self, cx: &mut Context<'_>) {
         let resumable = match self.activity {
             Activity::Joint {
                 target,
@@ -358,26 +433,21 @@ impl MotionController {
             self.paused = resumable;
         }
         self.clock.reset();
-        self.brake(now_us, None, bank, settings);
+        self.brake(cx, None);
     }
 
     /// Resumes a paused move (0x28); nothing to do if none is paused.
-    pub fn resume(
-        &mut self,
-        now_us: u64,
-        bank: &mut ServoBank,
-        settings: &Settings,
-    ) -> Result<(), AtomError> {
+    pub fn resume(&mut self, cx: &mut Context<'_>) -> Result<(), AtomError> {
         match self.paused.take() {
-            Some(t) => self.replace(now_us, Order::Move(t), bank, settings),
+            Some(t) => self.replace(cx, Order::Move(t)),
             None => Ok(()),
         }
     }
 
     /// Brakes and stays (a servo is about to be calibrated); queued moves wait.
-    pub fn halt(&mut self, now_us: u64, bank: &mut ServoBank, settings: &Settings) {
+    pub fn halt(&mut self, cx: &mut Context<'_>) {
         self.clock.reset();
-        self.brake(now_us, None, bank, settings);
+        self.brake(cx, None);
     }
 
     /// Forgets every motion without sending anything (the servos are about to be released).
@@ -401,10 +471,15 @@ impl MotionController {
         !matches!(self.activity, Activity::Idle)
     }
 
+    /// True at `now_us` while the arm moves: a motion runs or a joint reports moving.
+    pub fn is_moving(&self, bank: &ServoBank, now_us: u64) -> bool {
+        self.is_active() || bank.joints_moving(now_us)
+    }
+
     /// The joint angles the arm is going to (the present angles when idle).
-    pub fn planned_angles(&self, bank: &ServoBank, settings: &Settings) -> [Centideg; JOINTS] {
+    pub fn planned_angles(&self, cx: &Context<'_>) -> [Centideg; JOINTS] {
         match &self.activity {
-            Activity::Idle => bank.present_angles(settings),
+            Activity::Idle => cx.present_angles(),
             Activity::Joint { target, .. }
             | Activity::Path { target, .. }
             | Activity::Stream { target, .. } => *target,
@@ -420,16 +495,18 @@ impl MotionController {
         }
     }
 
-    /// The pose a straight line or an arc is going to, if one runs.
-    pub fn planned_pose(&self) -> Option<Pose> {
-        match &self.activity {
+    /// The end pose the arm is going to: where a straight line or an arc ends, otherwise the
+    /// pose of [`Self::planned_angles`] (the present pose when idle).
+    pub fn planned_pose(&self, cx: &Context<'_>) -> Pose {
+        let path_end = match &self.activity {
             Activity::Path { way, .. } => way.and_then(|w| w.end_pose()),
             Activity::Braking {
                 then: Some(Order::Move(t)),
                 ..
             } => t.way.end_pose(),
             _ => None,
-        }
+        };
+        path_end.unwrap_or_else(|| cx.settings.cart().forward(&self.planned_angles(cx)))
     }
 
     /// Accepts a circular arc (0x8B, 0x8C) through `via` to `end` at `speed_percent`: from
@@ -437,43 +514,36 @@ impl MotionController {
     /// where the arm is. The whole arc is walked with the inverse kinematics before anything
     /// moves ([`plan_arc`]); in fresh mode it replaces the current motion, in queue mode its
     /// parts wait their turn.
-    #[allow(clippy::too_many_arguments)]
-    pub fn submit_arc(
+    fn submit_arc(
         &mut self,
-        now_us: u64,
+        cx: &mut Context<'_>,
         begin: Option<Pose>,
         via: Pose,
         end: Pose,
         speed_percent: u8,
-        bank: &mut ServoBank,
-        settings: &Settings,
     ) -> Result<(), AtomError> {
-        if !bank.powered() {
-            return Err(AtomError::PoweredOff);
-        }
+        let settings = cx.settings;
         // Where the arc starts from: where the arm comes to rest (fresh mode), or where the
         // moves before it end (queue mode).
         let mut from = if settings.fresh_mode() {
-            bank.present_angles(settings)
+            cx.present_angles()
         } else {
             self.queue
                 .back()
                 .and_then(|t| full_angles(&t.angles))
-                .unwrap_or_else(|| self.planned_angles(bank, settings))
+                .unwrap_or_else(|| self.planned_angles(cx))
         };
         let mut parts: heapless::Vec<Target, 2> = heapless::Vec::new();
         if let Some(begin) = begin {
             let cart = settings.cart();
-            let here =
-                crate::cartesian::from_kin(&cart.model().forward(&crate::cartesian::joints(&from)));
-            if !poses_within(&here, &begin, AT_ARC_START) {
+            if !tolerance::at_arc_start(&cart.forward(&from), &begin) {
                 let angles = cart.inverse(&begin, &from)?;
                 let line = Target {
                     angles: angles.map(Some),
                     speed_percent,
                     way: Way::Line(begin),
                 };
-                check(bank, settings, &line)?;
+                settings.check_angles(&line.angles)?;
                 parts.push(line).map_err(|_| AtomError::Busy)?;
                 from = angles;
             }
@@ -484,7 +554,7 @@ impl MotionController {
             speed_percent,
             way: Way::Arc { via, end },
         };
-        check(bank, settings, &arc)?;
+        settings.check_angles(&arc.angles)?;
         parts.push(arc).map_err(|_| AtomError::Busy)?;
         let mut parts = parts.into_iter();
         let Some(first) = parts.next() else {
@@ -492,7 +562,7 @@ impl MotionController {
         };
         if settings.fresh_mode() {
             self.forget_plans();
-            self.replace(now_us, Order::Move(first), bank, settings)?;
+            self.replace(cx, Order::Move(first))?;
             for t in parts {
                 self.queue.push_back(t).map_err(|_| AtomError::Busy)?;
             }
@@ -501,9 +571,8 @@ impl MotionController {
         if MOTION_QUEUE - self.queue.len() < 1 + parts.len() {
             return Err(AtomError::Busy);
         }
-        if matches!(self.activity, Activity::Idle) && self.queue.is_empty() && self.paused.is_none()
-        {
-            self.start(now_us, Order::Move(first), bank, settings)?;
+        if self.idle_with_nothing_waiting() {
+            self.start(cx, Order::Move(first))?;
         } else {
             self.queue.push_back(first).map_err(|_| AtomError::Busy)?;
         }
@@ -513,42 +582,33 @@ impl MotionController {
         Ok(())
     }
 
-    /// Runs what is due at `now_us`: the jog watchdog, the next point of a path, the end of a
-    /// stream or a stop, arrival, and the next queued move. An error (a path that cannot go
-    /// on, a queued move that became impossible) has stopped the arm and is to be recorded.
-    pub fn update(
-        &mut self,
-        now_us: u64,
-        bank: &mut ServoBank,
-        settings: &Settings,
-    ) -> Result<(), AtomError> {
-        let watchdog_us = settings.config().timing.jog_watchdog_us;
-        if self.jogging() && now_us.saturating_sub(self.last_host_cmd_us) >= watchdog_us {
-            self.stop(now_us, bank, settings);
+    /// Runs what is due at the step's time: the jog watchdog, the next point of a path, the end
+    /// of a stream or a stop, arrival, and the next queued move. An error (a path that cannot
+    /// go on, a queued move that became impossible) has stopped the arm and is to be recorded.
+    pub fn update(&mut self, cx: &mut Context<'_>) -> Result<(), AtomError> {
+        let watchdog_us = cx.settings.config().timing.jog_watchdog_us;
+        if self.jogging() && cx.now_us.saturating_sub(self.last_host_cmd_us) >= watchdog_us {
+            self.stop(cx);
             return Ok(());
         }
-        let outcome = self.advance(now_us, bank, settings);
+        let outcome = self.advance(cx);
         if let Err(e) = outcome {
             self.forget_plans();
-            self.brake(now_us, None, bank, settings);
+            self.brake(cx, None);
             return Err(e);
         }
         if matches!(self.activity, Activity::Idle)
             && self.paused.is_none()
             && let Some(next) = self.queue.pop_front()
         {
-            return self.start(now_us, Order::Move(next), bank, settings);
+            return self.start(cx, Order::Move(next));
         }
         Ok(())
     }
 
-    fn advance(
-        &mut self,
-        now_us: u64,
-        bank: &mut ServoBank,
-        settings: &Settings,
-    ) -> Result<(), AtomError> {
-        let period_us = settings.config().timing.interpolation_period_us;
+    fn advance(&mut self, cx: &mut Context<'_>) -> Result<(), AtomError> {
+        let now_us = cx.now_us;
+        let period_us = cx.settings.config().timing.interpolation_period_us;
         // What comes after the present activity, if it ends now.
         let mut next = None;
         let mut then = None;
@@ -561,7 +621,7 @@ impl MotionController {
                 ..
             } => {
                 let elapsed = now_us.saturating_sub(*started_us);
-                if arrived(bank, settings, target) || elapsed > *duration_us + MOVE_OVERTIME_US {
+                if arrived(cx, target) || elapsed > *duration_us + MOVE_OVERTIME_US {
                     next = Some(Activity::Idle);
                 }
             }
@@ -573,21 +633,19 @@ impl MotionController {
                 speed_percent,
                 ..
             } => {
-                if let Step::Point { angles, last } = runner.step(now_us, settings)? {
+                if let Step::Point { angles, last } = runner.step(now_us, cx.settings)? {
                     if jog.is_some() {
                         *target = angles;
                     }
-                    let cap = runner.joint_speed_cap();
-                    let goals = follower.goals_towards(
-                        bank,
-                        settings,
-                        &angles,
+                    let leg = Leg {
+                        target: angles,
                         period_us,
-                        cap,
-                        Pace::Together,
+                        speed_cap_steps_per_s: runner.joint_speed_cap(),
+                        pace: Pace::Together,
                         last,
-                    );
-                    bank.send_goals(settings, goals)?;
+                    };
+                    let goals = follower.goals_towards(cx, &leg);
+                    cx.send_goals(goals)?;
                     if last {
                         next = Some(arriving(now_us, angles, *speed_percent, period_us));
                     }
@@ -601,17 +659,18 @@ impl MotionController {
                 last_us,
             } => {
                 if stream_ended(now_us, *last_us) {
-                    let cap = settings.config().joint_speed_steps(*speed_percent);
-                    let goals = follower.goals_towards(
-                        bank,
-                        settings,
-                        target,
-                        *stream_period_us,
-                        cap,
-                        Pace::Free,
-                        true,
-                    );
-                    bank.send_goals(settings, goals)?;
+                    let leg = Leg {
+                        target: *target,
+                        period_us: *stream_period_us,
+                        speed_cap_steps_per_s: cx
+                            .settings
+                            .config()
+                            .joint_speed_steps(*speed_percent),
+                        pace: Pace::Free,
+                        last: true,
+                    };
+                    let goals = follower.goals_towards(cx, &leg);
+                    cx.send_goals(goals)?;
                     next = Some(arriving(now_us, *target, *speed_percent, *stream_period_us));
                 }
             }
@@ -620,7 +679,7 @@ impl MotionController {
                 then: after,
                 ..
             } => {
-                let settled = !bank.joints_moving() || now_us >= *until_us + BRAKE_SETTLE_MAX_US;
+                let settled = !cx.joints_moving() || now_us >= *until_us + BRAKE_SETTLE_MAX_US;
                 if now_us >= *until_us && settled {
                     then = after.take();
                     next = Some(Activity::Idle);
@@ -631,9 +690,14 @@ impl MotionController {
             self.activity = activity;
         }
         match then {
-            Some(order) => self.start(now_us, order, bank, settings),
+            Some(order) => self.start(cx, order),
             None => Ok(()),
         }
+    }
+
+    /// True while idle with no queued or paused move: a move in queue mode starts at once.
+    fn idle_with_nothing_waiting(&self) -> bool {
+        matches!(self.activity, Activity::Idle) && self.queue.is_empty() && self.paused.is_none()
     }
 
     /// True while a continuous jog runs (the watchdog's concern).
@@ -652,77 +716,59 @@ impl MotionController {
     }
 
     /// Starts `order` now if the arm is still, or after braking if it moves.
-    fn replace(
-        &mut self,
-        now_us: u64,
-        order: Order,
-        bank: &mut ServoBank,
-        settings: &Settings,
-    ) -> Result<(), AtomError> {
-        if self.is_active() || bank.joints_moving() {
-            self.brake(now_us, Some(order), bank, settings);
+    fn replace(&mut self, cx: &mut Context<'_>, order: Order) -> Result<(), AtomError> {
+        if self.is_moving(cx.bank, cx.now_us) {
+            self.brake(cx, Some(order));
             Ok(())
         } else {
-            self.start(now_us, order, bank, settings)
+            self.start(cx, order)
         }
     }
 
-    /// Brakes every joint; `then` starts once the arm is at rest.
-    fn brake(
-        &mut self,
-        now_us: u64,
-        then: Option<Order>,
-        bank: &mut ServoBank,
-        settings: &Settings,
-    ) {
-        if !bank.powered() {
+    /// Brakes every joint; `then` starts once the arm is at rest. A powered-off arm has
+    /// nothing to brake.
+    fn brake(&mut self, cx: &mut Context<'_>, then: Option<Order>) {
+        if !cx.bank.powered() {
             self.activity = Activity::Idle;
             return;
         }
-        let stop = Braking::of(bank, settings);
-        stop.send(bank, settings);
+        let stop = Braking::of(cx);
+        stop.send(cx);
         self.activity = Activity::Braking {
             rest: stop.rest,
-            until_us: now_us + stop.duration_us,
+            until_us: cx.now_us + stop.duration_us,
             then,
         };
     }
 
-    fn start(
-        &mut self,
-        now_us: u64,
-        order: Order,
-        bank: &mut ServoBank,
-        settings: &Settings,
-    ) -> Result<(), AtomError> {
+    fn start(&mut self, cx: &mut Context<'_>, order: Order) -> Result<(), AtomError> {
         match order {
             Order::Move(target) => match target.way {
-                Way::Line(_) | Way::Arc { .. } => self.start_path(now_us, target, bank, settings),
-                Way::Joints => self.start_joint_move(now_us, target, None, bank, settings),
+                Way::Line(_) | Way::Arc { .. } => self.start_path(cx, target),
+                Way::Joints => self.start_joint_move(cx, target, None),
             },
             Order::Jog {
                 jog: jog @ Jog::Joint { joint, direction },
                 speed_percent,
             } => {
-                let end = jog_end(bank, settings, joint, direction)?;
-                let mut angles = [None; JOINTS];
-                if let Some(slot) = angles.get_mut(joint) {
-                    *slot = Some(end);
-                }
-                let target = Target::joints(angles, speed_percent);
-                self.start_joint_move(now_us, target, Some(jog), bank, settings)
+                let end = jog_end(cx, joint, direction)?;
+                let target = Target::joint(joint, end, speed_percent);
+                self.start_joint_move(cx, target, Some(jog))
             }
             Order::Jog {
                 jog: jog @ Jog::Pose { axis, direction },
                 speed_percent,
             } => {
-                if !bank.powered() {
-                    return Err(AtomError::PoweredOff);
-                }
-                let present = bank.present_angles(settings);
+                let present = cx.present_angles();
                 let positive = direction == JogDirection::Positive;
-                let runner =
-                    PathRunner::jog(settings, now_us, &present, axis, positive, speed_percent);
+                let runner = PathRunner::jog(
+                    cx.settings,
+                    cx.now_us,
+                    &present,
+                    axis,
+                    positive,
+                    speed_percent,
+                );
                 self.activity = Activity::Path {
                     runner,
                     follower: Follower::default(),
@@ -739,13 +785,12 @@ impl MotionController {
     /// Sends the goals of a planned joint move now.
     fn start_joint_move(
         &mut self,
-        now_us: u64,
+        cx: &mut Context<'_>,
         target: Target,
         jog: Option<Jog>,
-        bank: &mut ServoBank,
-        settings: &Settings,
     ) -> Result<(), AtomError> {
-        check(bank, settings, &target)?;
+        let settings = cx.settings;
+        settings.check_angles(&target.angles)?;
         let steps = core::array::from_fn(|j| {
             target
                 .angles
@@ -756,14 +801,14 @@ impl MotionController {
         });
         let (goals, duration_us) = plan::plan_joint_move(
             settings.config(),
-            &bank.present_steps(),
+            &cx.bank.present_steps(),
             &steps,
             target.speed_percent,
         );
-        bank.send_goals(settings, goals)?;
-        let present = bank.present_angles(settings);
+        cx.send_goals(goals)?;
+        let present = cx.present_angles();
         let full = core::array::from_fn(|j| {
-            let holding = bank.last_goal(j).map(|g| settings.angle(j, g.position));
+            let holding = cx.bank.last_goal(j).map(|g| settings.angle(j, g.position));
             target
                 .angles
                 .get(j)
@@ -775,7 +820,7 @@ impl MotionController {
         self.activity = Activity::Joint {
             target: full,
             speed_percent: target.speed_percent,
-            started_us: now_us,
+            started_us: cx.now_us,
             duration_us,
             jog,
         };
@@ -784,16 +829,12 @@ impl MotionController {
 
     /// Starts the Cartesian path of `target` (a straight line or an arc) from the present
     /// position; `target.angles` solve its end.
-    fn start_path(
-        &mut self,
-        now_us: u64,
-        target: Target,
-        bank: &mut ServoBank,
-        settings: &Settings,
-    ) -> Result<(), AtomError> {
-        check(bank, settings, &target)?;
-        let present = bank.present_angles(settings);
+    fn start_path(&mut self, cx: &mut Context<'_>, target: Target) -> Result<(), AtomError> {
+        let settings = cx.settings;
+        settings.check_angles(&target.angles)?;
+        let present = cx.present_angles();
         let speed = target.speed_percent;
+        let now_us = cx.now_us;
         let runner = match target.way {
             Way::Line(pose) => PathRunner::line(settings, now_us, &present, &pose, speed)?,
             Way::Arc { via, end } => {
@@ -818,27 +859,30 @@ impl MotionController {
     /// Follows the next target of a stream that arrives every `period_us`.
     fn follow_stream(
         &mut self,
-        now_us: u64,
+        cx: &mut Context<'_>,
         angles: [Centideg; JOINTS],
         speed_percent: u8,
         period_us: u64,
-        bank: &mut ServoBank,
-        settings: &Settings,
     ) -> Result<(), AtomError> {
         let mut follower = match self.activity {
             Activity::Stream { follower, .. } => follower,
             _ => Follower::default(),
         };
-        let cap = settings.config().joint_speed_steps(speed_percent);
-        let goals =
-            follower.goals_towards(bank, settings, &angles, period_us, cap, Pace::Free, false);
-        bank.send_goals(settings, goals)?;
+        let leg = Leg {
+            target: angles,
+            period_us,
+            speed_cap_steps_per_s: cx.settings.config().joint_speed_steps(speed_percent),
+            pace: Pace::Free,
+            last: false,
+        };
+        let goals = follower.goals_towards(cx, &leg);
+        cx.send_goals(goals)?;
         self.activity = Activity::Stream {
             follower,
             target: angles,
             speed_percent,
             period_us,
-            last_us: now_us,
+            last_us: cx.now_us,
         };
         Ok(())
     }
@@ -874,31 +918,6 @@ fn rest_of(way: Way, runner: &PathRunner) -> Way {
     }
 }
 
-/// True if two poses are within `(position, orientation)` wire units of each other (0.1 mm,
-/// 0.01 deg; angles wrap at 360 deg).
-fn poses_within(a: &Pose, b: &Pose, (position, orientation): (i32, i32)) -> bool {
-    a.to_array()
-        .iter()
-        .zip(&b.to_array())
-        .enumerate()
-        .all(|(i, (x, y))| {
-            let d = (i32::from(*x) - i32::from(*y)).abs();
-            if i < 3 {
-                d <= position
-            } else {
-                d.min(36_000 - d) <= orientation
-            }
-        })
-}
-
-/// Checks a target against power and limits without moving.
-fn check(bank: &ServoBank, settings: &Settings, target: &Target) -> Result<(), AtomError> {
-    if !bank.powered() {
-        return Err(AtomError::PoweredOff);
-    }
-    settings.check_angles(&target.angles)
-}
-
 /// All six angles, if all are given.
 fn full_angles(angles: &[Option<Centideg>; JOINTS]) -> Option<[Centideg; JOINTS]> {
     let mut full = [Centideg(0); JOINTS];
@@ -910,21 +929,13 @@ fn full_angles(angles: &[Option<Centideg>; JOINTS]) -> Option<[Centideg; JOINTS]
 
 /// The limit a jog of joint `j` in `direction` runs to. A joint already past that limit (the
 /// user tightened it) would be dragged backwards, against the direction asked for: refused.
-fn jog_end(
-    bank: &ServoBank,
-    settings: &Settings,
-    j: usize,
-    direction: JogDirection,
-) -> Result<Centideg, AtomError> {
-    if !bank.powered() {
-        return Err(AtomError::PoweredOff);
-    }
-    let limit = settings.limit(j).ok_or(AtomError::Invalid)?;
+fn jog_end(cx: &Context<'_>, j: usize, direction: JogDirection) -> Result<Centideg, AtomError> {
+    let limit = cx.settings.limit(j).ok_or(AtomError::Invalid)?;
     let end = match direction {
         JogDirection::Negative => limit.min,
         JogDirection::Positive => limit.max,
     };
-    let present = bank.present_angles(settings).get(j).copied().unwrap_or(end);
+    let present = cx.present_angles().get(j).copied().unwrap_or(end);
     let beyond = match direction {
         JogDirection::Positive => present > end,
         JogDirection::Negative => present < end,
@@ -936,16 +947,148 @@ fn jog_end(
     }
 }
 
-/// True if the joints that answer are within [`IN_POSITION_CENTIDEG`] of `target` and none of
-/// them reports moving (a servo that does not answer cannot arrive: it is judged by the rest).
-fn arrived(bank: &ServoBank, settings: &Settings, target: &[Centideg; JOINTS]) -> bool {
-    let present = bank.present_angles(settings);
+/// True if the joints that answer are within [`tolerance::IN_POSITION_CENTIDEG`] of `target`
+/// and none of them reports moving (a servo that does not answer cannot arrive: it is judged by
+/// the rest).
+fn arrived(cx: &Context<'_>, target: &[Centideg; JOINTS]) -> bool {
+    let present = cx.present_angles();
     let seen: [Centideg; JOINTS] = core::array::from_fn(|j| {
-        if bank.health(j).is_some_and(|h| h.answering) {
+        if cx.bank.health(j).is_some_and(|h| h.answering) {
             present.get(j).copied().unwrap_or_default()
         } else {
             target.get(j).copied().unwrap_or_default()
         }
     });
-    angles_match(&seen, target) && !bank.joints_moving()
+    tolerance::angles_match(&seen, target) && !cx.joints_moving()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::at_rest;
+    use crate::config::AtomConfig;
+    use crate::settings::Settings;
+
+    #[test]
+    fn every_new_motion_is_refused_while_powered_off() {
+        let settings = Settings::new(AtomConfig::default());
+        let mut bank = ServoBank::new(&settings);
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        let pose = settings.cart().forward(&[Centideg(0); JOINTS]);
+        let commands = [
+            Command::Move(Target::joint(0, Centideg(1_000), 50)),
+            Command::ToPose {
+                pose,
+                speed_percent: 50,
+                mode: MoveMode::Linear,
+            },
+            Command::Arc {
+                begin: None,
+                via: pose,
+                end: pose,
+                speed_percent: 50,
+            },
+            Command::JogJoint {
+                joint: 0,
+                direction: JogDirection::Positive,
+                speed_percent: 50,
+            },
+            Command::JogPose {
+                axis: 2,
+                direction: JogDirection::Negative,
+                speed_percent: 50,
+            },
+        ];
+        for command in commands {
+            assert_eq!(motion.command(cx, command), Err(AtomError::PoweredOff));
+        }
+        assert!(!motion.is_active());
+    }
+
+    #[test]
+    fn queue_mode_runs_the_moves_in_turn() {
+        let (mut settings, mut bank) = at_rest();
+        settings.set_fresh_mode(false);
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        let first = Target::joint(0, Centideg(1_000), 100);
+        let second = Target::joint(1, Centideg(500), 100);
+        assert_eq!(motion.command(cx, Command::Move(first)), Ok(()));
+        assert_eq!(motion.command(cx, Command::Move(second)), Ok(()));
+        assert_eq!(motion.planned_angles(cx)[0], Centideg(1_000));
+        assert_eq!(
+            motion.planned_angles(cx)[1],
+            Centideg(0),
+            "the second waits"
+        );
+        // The servos never report arriving here: the first move ends after its overtime.
+        cx.now_us = 10 * MOVE_OVERTIME_US;
+        assert_eq!(motion.update(cx), Ok(()));
+        assert_eq!(motion.planned_angles(cx)[1], Centideg(500), "its turn");
+        let held = settings.angle(0, settings.goal_steps(0, Centideg(1_000)));
+        assert_eq!(motion.planned_angles(cx)[0], held, "joint 1 holds its goal");
+    }
+
+    #[test]
+    fn a_fresh_move_replaces_a_running_one_after_braking() {
+        let (settings, mut bank) = at_rest();
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        let first = Target::joint(0, Centideg(1_000), 100);
+        let second = Target::joint(1, Centideg(500), 100);
+        assert_eq!(motion.command(cx, Command::Move(first)), Ok(()));
+        cx.now_us = 200_000;
+        assert_eq!(motion.command(cx, Command::Move(second)), Ok(()));
+        assert!(matches!(motion.activity, Activity::Braking { .. }));
+        assert_eq!(motion.planned_angles(cx)[1], Centideg(500));
+        cx.now_us = 400_000;
+        assert_eq!(motion.update(cx), Ok(()));
+        assert!(matches!(motion.activity, Activity::Joint { .. }), "started");
+    }
+
+    #[test]
+    fn stop_brakes_and_forgets_the_queued_moves() {
+        let (mut settings, mut bank) = at_rest();
+        settings.set_fresh_mode(false);
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        for j in 0..3 {
+            let target = Target::joint(j, Centideg(1_000), 100);
+            assert_eq!(motion.command(cx, Command::Move(target)), Ok(()));
+        }
+        motion.stop(cx);
+        assert!(matches!(
+            motion.activity,
+            Activity::Braking { then: None, .. }
+        ));
+        cx.now_us = 10 * MOVE_OVERTIME_US;
+        assert_eq!(motion.update(cx), Ok(()));
+        assert!(!motion.is_active(), "nothing queued starts");
+    }
+
+    #[test]
+    fn a_jog_stops_when_the_host_falls_silent() {
+        let (settings, mut bank) = at_rest();
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        let jog = Command::JogJoint {
+            joint: 0,
+            direction: JogDirection::Positive,
+            speed_percent: 50,
+        };
+        motion.note_host_command(0);
+        assert_eq!(motion.command(cx, jog), Ok(()));
+        assert!(motion.jogging());
+        let watchdog_us = settings.config().timing.jog_watchdog_us;
+        cx.now_us = watchdog_us - 1;
+        assert_eq!(motion.update(cx), Ok(()));
+        assert!(motion.jogging());
+        cx.now_us = watchdog_us;
+        assert_eq!(motion.update(cx), Ok(()));
+        assert!(
+            matches!(motion.activity, Activity::Braking { .. }),
+            "stopped"
+        );
+    }
 }

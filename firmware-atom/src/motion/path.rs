@@ -356,3 +356,71 @@ fn pose_error(a: &Transform, b: &Transform) -> i128 {
     // (16 000 / (0.0175 * 2^30))^2 = 1 / 1 370 000 scales a degree to a millimetre.
     position + rotation / 1_370_000
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bank::test_support::powered;
+    use protocol_core::units::DeciMm;
+
+    /// A pose of the arm away from its singularities.
+    const FROM: [Centideg; JOINTS] = [
+        Centideg(1_000),
+        Centideg(-3_000),
+        Centideg(-6_000),
+        Centideg(2_000),
+        Centideg(4_500),
+        Centideg(1_000),
+    ];
+
+    #[test]
+    fn a_line_speeds_up_a_period_at_a_time_and_ends_on_its_pose() {
+        let settings = powered();
+        let start = settings.cart().forward(&FROM);
+        let end = Pose {
+            x: DeciMm(start.x.0 - 300),
+            ..start
+        };
+        let mut runner = PathRunner::line(&settings, 0, &FROM, &end, 100).unwrap();
+        let period = settings.config().timing.interpolation_period_us;
+        let mut now = 0;
+        let mut steps = std::vec::Vec::new();
+        let last = loop {
+            let Step::Point { angles, last } = runner.step(now, &settings).unwrap() else {
+                panic!("a point every period");
+            };
+            assert_eq!(runner.step(now + period - 1, &settings), Ok(Step::Wait));
+            steps.push(runner.speed_um_per_s);
+            if last {
+                break angles;
+            }
+            now += period;
+            assert!(steps.len() < 1_000, "the line ends");
+        };
+        assert!(
+            steps[0] < steps[1] && steps[1] < steps[2],
+            "ramps up: {steps:?}"
+        );
+        let reached = settings.cart().forward(&last);
+        for (a, b) in reached.to_array().iter().zip(end.to_array()) {
+            assert!(
+                (i32::from(*a) - i32::from(b)).abs() <= 3,
+                "{reached:?} vs {end:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn an_arc_without_a_circle_is_refused_before_anything_moves() {
+        let settings = powered();
+        let start = settings.cart().forward(&FROM);
+        let on_the_line = |dx: i16| Pose {
+            x: DeciMm(start.x.0 - dx),
+            ..start
+        };
+        assert_eq!(
+            plan_arc(&settings, &FROM, &on_the_line(100), &on_the_line(200)).map(|_| ()),
+            Err(AtomError::Path(PathError::NoCircle))
+        );
+    }
+}

@@ -1,14 +1,10 @@
 //! Planned joint moves: how fast each servo must go so that a joint-interpolated move arrives
 //! everywhere at once (the servos' own ramps carry it out).
 
-use protocol_core::units::{Centideg, Steps};
+use protocol_core::units::Steps;
 
 use crate::config::{AtomConfig, JOINTS};
-use crate::safety::{Goal, GoalSet};
-
-/// Joint-angle tolerance of "is in position" and of the end of a move: one degree, a little
-/// more than the servo's dead band plus one encoder step.
-pub const IN_POSITION_CENTIDEG: i32 = 100;
+use crate::safety::{Goal, Goals};
 
 /// A move waits at most this long beyond its planned duration before it is declared done
 /// (a stalled or missing servo must not block the queue forever).
@@ -22,7 +18,7 @@ pub fn plan_joint_move(
     present: &[Steps; JOINTS],
     target: &[Option<Steps>; JOINTS],
     speed_percent: u8,
-) -> (GoalSet, u64) {
+) -> (Goals, u64) {
     let travel = |j: usize| -> u32 {
         match (target.get(j).copied().flatten(), present.get(j)) {
             (Some(t), Some(p)) => (i32::from(t.0) - i32::from(p.0)).unsigned_abs(),
@@ -32,15 +28,19 @@ pub fn plan_joint_move(
     let longest = (0..JOINTS).map(travel).max().unwrap_or(0).max(1);
     let v_max = config.joint_speed_steps(speed_percent);
     let a_max = u32::from(config.joint_accel_register());
-    let mut goals: GoalSet = [None; crate::config::SERVOS];
-    for (j, slot) in goals.iter_mut().take(JOINTS).enumerate() {
+    let mut goals = Goals::NONE;
+    for j in 0..JOINTS {
         if let Some(position) = target.get(j).copied().flatten() {
             let share = travel(j);
-            *slot = Some(Goal {
-                position,
-                speed_steps_per_s: (v_max * share / longest).clamp(1, u32::from(u16::MAX)) as u16,
-                accel: (a_max * share / longest).clamp(1, 254) as u8,
-            });
+            goals.set(
+                j,
+                Some(Goal {
+                    position,
+                    speed_steps_per_s: (v_max * share / longest).clamp(1, u32::from(u16::MAX))
+                        as u16,
+                    accel: (a_max * share / longest).clamp(1, 254) as u8,
+                }),
+            );
         }
     }
     // Trapezoid: travel / v + v / a (the ramp up and down add one ramp's time).
@@ -48,14 +48,6 @@ pub fn plan_joint_move(
     let duration_us = u64::from(longest) * 1_000_000 / u64::from(v_max)
         + u64::from(v_max) * 1_000_000 / u64::from(accel_steps.max(1));
     (goals, duration_us)
-}
-
-/// True if every joint of `present` is within [`IN_POSITION_CENTIDEG`] of `target`.
-pub fn angles_match(present: &[Centideg; JOINTS], target: &[Centideg; JOINTS]) -> bool {
-    present
-        .iter()
-        .zip(target)
-        .all(|(p, t)| (i32::from(p.0) - i32::from(t.0)).abs() <= IN_POSITION_CENTIDEG)
 }
 
 #[cfg(test)]
@@ -75,7 +67,7 @@ mod tests {
             Some(Steps(2048)),
         ];
         let (goals, duration) = plan_joint_move(&cfg, &present, &target, 100);
-        let speed = |j: usize| u32::from(goals[j].unwrap().speed_steps_per_s);
+        let speed = |j: usize| u32::from(goals.get(j).unwrap().speed_steps_per_s);
         let v_max = cfg.joint_speed_steps(100);
         assert_eq!(speed(0), v_max);
         assert_eq!(speed(1), v_max / 2);
@@ -85,7 +77,7 @@ mod tests {
             1,
             "a joint that stays put never gets speed 0 (= full speed)"
         );
-        assert!(goals[3].is_none());
+        assert!(goals.get(3).is_none());
         // 1000 steps at 1706 steps/s plus one ramp.
         assert!((500_000..1_500_000).contains(&duration), "{duration}");
     }
