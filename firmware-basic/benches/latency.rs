@@ -17,26 +17,6 @@ use common::{Rig, ack_everything, frame};
 use firmware_basic::{BasicConfig, EchoMode};
 use protocol_core::timing;
 
-/// The Atom's servo polling as it looks on the wire: an 8-byte READ, the servo's turnaround,
-/// a 21-byte status, then the Atom's gap between transactions. Returns the period in ns.
-fn inject_servo_traffic(rig: &mut Rig, from_ns: u64, until_ns: u64) -> u64 {
-    let read = [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x0F, 0xB1];
-    let status: Vec<u8> = [0xFF, 0xFF, 0x01, 0x11, 0x00]
-        .into_iter()
-        .chain([0x10; 16])
-        .collect();
-    let byte = common::BUS_BYTE_NS;
-    let turnaround = timing::SERVO_TURNAROUND_MAX_US * 1_000;
-    let period = 8 * byte + turnaround + 21 * byte + timing::ATOM_TRANSACTION_GAP_US * 1_000;
-    let mut t = from_ns;
-    while t < until_ns {
-        rig.wire().inject(t, &read);
-        rig.wire().inject(t + 8 * byte + turnaround, &status);
-        t += period;
-    }
-    period
-}
-
 /// Latencies in ns of `rounds` exchanges of `request` (host -> bus and bus -> host), on an
 /// idle wire or one busy with the Atom's servo polling.
 fn measure(
@@ -67,12 +47,11 @@ fn measure(
         rig.step_ns = saved;
         rig.atom_delay_ns = 150_000 + (round as u64 * 3_331) % 10_000;
         if servo_traffic {
+            // The Atom polls a servo by its bus schedule (29-byte transactions, 100 us gaps,
+            // held while the Basic talks in a gap), from a varying phase.
             let now = rig.now_ns;
-            inject_servo_traffic(
-                &mut rig,
-                now + (round as u64 * 7_919) % 400_000,
-                now + 6_000_000,
-            );
+            rig.wire()
+                .poll_servos(now + (round as u64 * 7_919) % 400_000, now + 6_000_000);
         }
         let sent_before = rig.wire().basic_sent.len();
         let host_before = rig.host.from_basic.len();

@@ -584,3 +584,44 @@ fn the_basic_never_starts_late_in_the_atoms_gap() {
         assert_eq!(rig.host.received(), angles_reply());
     }
 }
+
+#[test]
+fn a_request_in_the_atoms_gap_is_answered_while_it_polls_servos() {
+    use protocol_core::timing::ATOM_TRANSACTION_GAP_US;
+    // The Basic starts early in the Atom's gap; the Atom hears its first byte before the gap
+    // is over and holds its next servo transaction (firmware-atom's bus schedule), so nothing
+    // collides, with or without the echo: the request reaches the Atom once and its reply the
+    // host. The polling is under way when the request arrives (its first READ starts before
+    // the request's last byte reaches the Basic, 424 us in), at 40 phases across its 430 us
+    // period.
+    for echo in [true, false] {
+        for phase in 0..40 {
+            let mut rig = Rig::quiet(echo);
+            rig.step_ns = 10_000;
+            rig.atom_delay_ns = 150_000;
+            rig.run_us(1_000);
+            let now = rig.now_ns;
+            let from = now + (phase * 10_997) % 420_000;
+            rig.wire().poll_servos(from, now + 4_000_000);
+            rig.host.send(&frame(GET_ANGLES, &[]));
+            rig.run_us(3_000);
+            let case = format!("echo {echo}, servo polling from +{} ns", from - now);
+            assert_eq!(rig.host.received(), angles_reply(), "{case}");
+            assert_eq!(rig.atom_got.len(), 1, "{case}");
+            assert_eq!(rig.wire().collisions(), 0, "{case}");
+            assert_eq!(rig.basic.status().collisions, 0, "{case}");
+            // The Atom kept its gap after the Basic's bytes, and kept polling.
+            let wire = rig.wire();
+            assert!(wire.servo_reads.len() > 4, "{case}");
+            for &read in &wire.servo_reads {
+                assert!(
+                    wire.basic_sent.iter().all(|&(start, _)| {
+                        start >= read
+                            || start + BUS_BYTE_NS + ATOM_TRANSACTION_GAP_US * 1_000 <= read
+                    }),
+                    "{case}: READ at {read} ns within the Atom's gap after the Basic's bytes"
+                );
+            }
+        }
+    }
+}

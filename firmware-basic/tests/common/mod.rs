@@ -4,7 +4,7 @@
 //!
 //! Two transmissions that overlap on the bus garble each other for every listener. The Basic
 //! hears everything the others send, and its own bytes when `echo` is on; the scripted Atom
-//! listens to the Basic.
+//! listens to the Basic, and can poll a servo by the Atom's bus schedule ([`Wire::poll_servos`]).
 #![allow(dead_code, clippy::unwrap_used, clippy::indexing_slicing)]
 
 pub mod clients;
@@ -24,6 +24,31 @@ use sim_hw::{Bus, HeardByte, StationId};
 pub const BUS_BYTE_NS: u64 = timing::wire_time_ns(1, timing::BUS_BAUD);
 /// Nanoseconds of one byte on the host link.
 pub const HOST_BYTE_NS: u64 = timing::wire_time_ns(1, timing::HOST_BAUD);
+
+/// The Atom's servo poll: a READ of servo 1's state (present position and more)...
+pub const SERVO_READ: [u8; 8] = [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x0F, 0xB1];
+/// ...and the servo's 21-byte status answering it.
+pub const SERVO_STATUS: [u8; 21] = [
+    0xFF, 0xFF, 0x01, 0x11, 0x00, 0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x10,
+    0x10, 0x10, 0x10, 0x10, 0x10,
+];
+/// One servo transaction at most, READ, turnaround and status, in ns.
+pub const SERVO_TRANSACTION_NS: u64 = (SERVO_READ.len() + SERVO_STATUS.len()) as u64 * BUS_BYTE_NS
+    + timing::SERVO_TURNAROUND_MAX_US * 1_000;
+
+/// The scripted Atom polling a servo as `firmware-atom`'s bus schedule does: a transaction
+/// starts only after [`timing::ATOM_TRANSACTION_GAP_US`] of quiet on the wire (whoever spoke
+/// last), never while it has a reply to send, and not while a frame it hears is unfinished
+/// (until the frame gap cuts it short).
+struct ServoPolling {
+    /// No transaction starts before this, ns: the start asked for, then the end of the last
+    /// transaction and the gap.
+    not_before_ns: u64,
+    /// No transaction starts from this time on, ns.
+    until_ns: u64,
+    /// The bytes of the READ on the wire heard so far; `None` between transactions.
+    read_heard: Option<Vec<u8>>,
+}
 
 /// The shared wire: `sim-hw`'s bus with the Basic, the scripted Atom and other stations
 /// (servo traffic, noise) attached.
@@ -48,6 +73,12 @@ pub struct Wire {
     atom_outbox: VecDeque<(u64, Vec<u8>)>,
     /// When the Atom tries its waiting answer again, ns.
     atom_retry_ns: Option<u64>,
+    /// The Atom's servo polling, while on.
+    servo_polling: Option<ServoPolling>,
+    /// The Atom has heard the start of a frame that has not ended.
+    atom_frame_open: bool,
+    /// When each of the Atom's servo READs started, ns.
+    pub servo_reads: Vec<u64>,
 }
 
 impl Wire {
@@ -70,6 +101,80 @@ impl Wire {
             atom_rx: VecDeque::new(),
             atom_outbox: VecDeque::new(),
             atom_retry_ns: None,
+            servo_polling: None,
+            atom_frame_open: false,
+            servo_reads: Vec::new(),
+        }
+    }
+
+    /// The Atom polls servo 1 ([`SERVO_READ`], answered by [`SERVO_STATUS`] after the longest
+    /// turnaround) from `from_ns` until `until_ns`, one transaction after another as its bus
+    /// schedule allows: it holds back while the Basic talks in its gap, and while it answers.
+    pub fn poll_servos(&mut self, from_ns: u64, until_ns: u64) {
+        self.servo_polling = Some(ServoPolling {
+            not_before_ns: from_ns,
+            until_ns,
+            read_heard: None,
+        });
+    }
+
+    /// Bytes garbled by overlapping transmissions so far.
+    pub fn collisions(&self) -> u64 {
+        self.bus.collisions()
+    }
+
+    /// When the Atom's next servo transaction may start, ns, if nothing but time holds it.
+    fn servo_poll_due_ns(&self) -> Option<u64> {
+        let polling = self.servo_polling.as_ref()?;
+        if polling.read_heard.is_some() || self.bus.busy() || !self.atom_outbox.is_empty() {
+            // A byte's end, or the Atom's answer, comes first.
+            return None;
+        }
+        let hold_us = if self.atom_frame_open {
+            timing::BUS_FRAME_GAP_US
+        } else {
+            timing::ATOM_TRANSACTION_GAP_US
+        };
+        let due = polling
+            .not_before_ns
+            .max(self.bus.last_activity_ns() + hold_us * 1_000);
+        (due < polling.until_ns).then_some(due)
+    }
+
+    /// Starts the Atom's next servo READ if its schedule allows it now.
+    fn servo_poll(&mut self) {
+        let now = self.now_ns;
+        if self.servo_poll_due_ns().is_none_or(|due| due > now) {
+            return;
+        }
+        if let Some(polling) = self.servo_polling.as_mut() {
+            polling.read_heard = Some(Vec::new());
+            polling.not_before_ns =
+                now + SERVO_TRANSACTION_NS + timing::ATOM_TRANSACTION_GAP_US * 1_000;
+            self.bus.port(self.atom).unwrap().write(&SERVO_READ);
+            self.servo_reads.push(now);
+        }
+    }
+
+    /// Follows the Atom's READ on the wire: a servo answers one that arrived intact.
+    fn servo_hears(&mut self, byte: u8, end_ns: u64) {
+        let Some(polling) = self.servo_polling.as_mut() else {
+            return;
+        };
+        let Some(read) = polling.read_heard.as_mut() else {
+            return;
+        };
+        read.push(byte);
+        if read.len() < SERVO_READ.len() {
+            return;
+        }
+        let intact = read[..] == SERVO_READ;
+        polling.read_heard = None;
+        if intact {
+            self.inject(
+                end_ns + timing::SERVO_TURNAROUND_MAX_US * 1_000,
+                &SERVO_STATUS,
+            );
         }
     }
 
@@ -114,6 +219,7 @@ impl Wire {
             self.bus.next_event_ns(),
             self.scheduled.front().map(|(t, _, _)| *t),
             self.atom_retry_ns,
+            self.servo_poll_due_ns(),
         ]
         .into_iter()
         .flatten()
@@ -125,12 +231,16 @@ impl Wire {
         self.now_ns = now_ns;
         self.bus.deliver(now_ns);
         self.bus.take_heard(&mut self.heard);
-        for h in self.heard.drain(..) {
+        let mut heard = std::mem::take(&mut self.heard);
+        for h in heard.drain(..) {
             self.last_from = Some(h.from);
             if h.from == self.basic {
                 self.atom_rx.push_back((h.end_ns, h.byte));
+            } else if h.from == self.atom {
+                self.servo_hears(h.byte, h.end_ns);
             }
         }
+        self.heard = heard;
         while let Some((_, station, bytes)) = self.scheduled.pop_front_if(|(t, _, _)| *t <= now_ns)
         {
             self.bus.port(station).unwrap().write(&bytes);
@@ -478,6 +588,8 @@ impl Rig {
         }
         self.wire.arrive(self.now_ns);
         self.run_atom();
+        // Before the Basic's poll: neither hears what the other starts in this instant.
+        self.wire.servo_poll();
         self.host.now_ns = self.now_ns;
         for client in self.clients.iter_mut().flatten() {
             client.now_ns = self.now_ns;
@@ -498,6 +610,7 @@ impl Rig {
     fn wire_instant(&mut self, t_ns: u64) {
         self.wire.arrive(t_ns);
         self.run_atom();
+        self.wire.servo_poll();
         self.atom_send();
         self.wire.start_transmissions();
     }
@@ -541,6 +654,7 @@ impl Rig {
             self.atom_rx.on_time(at / 1_000, &mut on_heard);
             self.atom_rx.push(at / 1_000, b, &mut on_heard);
         }
+        self.wire.atom_frame_open = self.atom_rx.frame_in_progress();
         for (at, frame) in frames {
             self.atom_got.push((at, frame.clone()));
             if let Some(reply) = (self.atom)(&frame) {
