@@ -18,6 +18,16 @@ impl<'a> Reader<'a> {
         Self { data }
     }
 
+    /// Bytes not read yet.
+    pub(crate) fn remaining(&self) -> usize {
+        self.data.len()
+    }
+
+    /// Every byte not read yet.
+    pub(crate) fn rest(&mut self) -> &'a [u8] {
+        core::mem::take(&mut self.data)
+    }
+
     pub(crate) fn u8(&mut self) -> Option<u8> {
         let (&first, rest) = self.data.split_first()?;
         self.data = rest;
