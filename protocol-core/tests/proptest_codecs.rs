@@ -651,3 +651,22 @@ fn request_strategies_cover_every_kind_and_command() {
     let all: std::collections::BTreeSet<u8> = cmd::ALL.into_iter().collect();
     assert_eq!(codes, all);
 }
+
+/// The reply strategy draws every kind of reply.
+#[test]
+fn reply_strategy_covers_every_kind() {
+    use proptest::strategy::ValueTree;
+    use proptest::test_runner::TestRunner;
+    let mut runner = TestRunner::deterministic();
+    let strategy = reply();
+    let mut kinds = std::collections::BTreeSet::new();
+    for _ in 0..2000 {
+        kinds.insert(format!(
+            "{:?}",
+            strategy.new_tree(&mut runner).unwrap().current().kind()
+        ));
+    }
+    let all: std::collections::BTreeSet<String> =
+        ReplyKind::ALL.iter().map(|k| format!("{k:?}")).collect();
+    assert_eq!(kinds, all);
+}
