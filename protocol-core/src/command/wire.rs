@@ -77,7 +77,8 @@ impl<'a> Reader<'a> {
     }
 }
 
-/// Builds a frame's data; bytes beyond [`MAX_DATA`] are dropped (no layout comes close).
+/// Builds a frame's data; bytes beyond [`MAX_DATA`] are dropped (no layout is longer: only the
+/// free-form payload of 0xB0 reaches it).
 #[derive(Default)]
 pub(crate) struct Writer {
     data: Vec<u8, MAX_DATA>,
