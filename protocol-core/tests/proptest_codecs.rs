@@ -75,138 +75,166 @@ fn atom_output_pin() -> impl Strategy<Value = AtomPin> {
 fn select(all: ServoSelect) -> impl Strategy<Value = ServoSelect> {
     prop_oneof![Just(all), servo().prop_map(ServoSelect::One)]
 }
-/// Every request whose frame is LEN 2 (no data).
-fn no_data_requests() -> Vec<Request> {
-    cmd::ALL
-        .into_iter()
-        .filter_map(|c| Request::parse(&Frame::new(c, &[]).unwrap()).ok())
-        .collect()
-}
-
-/// One strategy per request layout (plus all data-less requests), so every variant is drawn.
-fn request_strategies() -> Vec<BoxedStrategy<Request>> {
+/// The requests of one kind: every value its fields may hold, every layout. The match has one
+/// arm per [`RequestKind`] and no wildcard, so a command added to the table in `request.rs`
+/// does not compile here until it has a strategy, and [`request`] draws from all of
+/// [`RequestKind::ALL`].
+fn request_of(kind: RequestKind) -> BoxedStrategy<Request> {
     use Request as R;
-    let mut all: Vec<BoxedStrategy<Request>> = no_data_requests()
-        .into_iter()
-        .map(|r| Just(r).boxed())
-        .collect();
-    all.extend([
-        any::<bool>()
-            .prop_map(|u| R::ReleaseAllServos { undamped: Some(u) })
+    use RequestKind as K;
+    match kind {
+        // --- status and system ---
+        K::GetModifyVersion => Just(R::GetModifyVersion).boxed(),
+        K::GetSystemVersion => Just(R::GetSystemVersion).boxed(),
+        K::ClearQueue => Just(R::ClearQueue).boxed(),
+        K::CheckAsyncOrSync => Just(R::CheckAsyncOrSync).boxed(),
+        K::GetErrorInfo => Just(R::GetErrorInfo).boxed(),
+        K::ClearErrorInfo => Just(R::ClearErrorInfo).boxed(),
+        K::PowerOn => Just(R::PowerOn).boxed(),
+        K::PowerOff => Just(R::PowerOff).boxed(),
+        K::IsPowerOn => Just(R::IsPowerOn).boxed(),
+        K::ReleaseAllServos => prop::option::of(any::<bool>())
+            .prop_map(|undamped| R::ReleaseAllServos { undamped })
             .boxed(),
-        any::<bool>()
+        K::IsControllerConnected => Just(R::IsControllerConnected).boxed(),
+        K::ReadNextError => Just(R::ReadNextError).boxed(),
+        K::SetFreshMode => any::<bool>()
             .prop_map(|fresh| R::SetFreshMode { fresh })
             .boxed(),
-        any::<bool>().prop_map(|on| R::SetFreeMode { on }).boxed(),
-        any::<bool>().prop_map(|on| R::SetVisionMode { on }).boxed(),
-        (joint(), any::<i16>(), speed())
+        K::GetFreshMode => Just(R::GetFreshMode).boxed(),
+        K::SetFreeMode => any::<bool>().prop_map(|on| R::SetFreeMode { on }).boxed(),
+        K::IsFreeMode => Just(R::IsFreeMode).boxed(),
+        K::SetVisionMode => any::<bool>().prop_map(|on| R::SetVisionMode { on }).boxed(),
+        K::GetRebootCount => Just(R::GetRebootCount).boxed(),
+        // --- motion ---
+        K::GetAngles => Just(R::GetAngles).boxed(),
+        K::SendAngle => (joint(), any::<i16>(), speed())
             .prop_map(|(joint, a, speed)| R::SendAngle {
                 joint,
                 angle: Centideg(a),
                 speed,
             })
             .boxed(),
-        (deg6(), speed())
+        K::SendAngles => (deg6(), speed())
             .prop_map(|(angles, speed)| R::SendAngles { angles, speed })
             .boxed(),
-        deg6()
+        K::GetCoords => Just(R::GetCoords).boxed(),
+        K::AnglesToCoords => deg6()
             .prop_map(|angles| R::AnglesToCoords { angles })
             .boxed(),
-        (axis_value(), speed())
+        K::SendCoord => (axis_value(), speed())
             .prop_map(|(target, speed)| R::SendCoord { target, speed })
             .boxed(),
-        (
+        K::SendCoords => (
             pose(),
             speed(),
             prop::option::of(prop_oneof![Just(MoveMode::Joint), Just(MoveMode::Linear)]),
         )
             .prop_map(|(pose, speed, mode)| R::SendCoords { pose, speed, mode })
             .boxed(),
-        prop_oneof![
+        K::Pause => Just(R::Pause).boxed(),
+        K::IsPaused => Just(R::IsPaused).boxed(),
+        K::Resume => Just(R::Resume).boxed(),
+        K::Stop => Just(R::Stop).boxed(),
+        K::IsInPosition => prop_oneof![
             deg6().prop_map(PositionTarget::Angles),
             pose().prop_map(PositionTarget::Coords)
         ]
         .prop_map(|target| R::IsInPosition { target })
         .boxed(),
-        (pose(), deg6())
-            .prop_map(|(target, current)| R::SolveIk { target, current })
-            .boxed(),
-        prop::array::uniform6(any::<u8>())
+        K::IsMoving => Just(R::IsMoving).boxed(),
+        K::SetPid => prop::array::uniform6(any::<u8>())
             .prop_map(|gains| R::SetPid { gains })
             .boxed(),
-        (pose(), pose(), pose())
+        K::GetPid => Just(R::GetPid).boxed(),
+        K::MoveCCoords => (pose(), pose(), pose())
             .prop_map(|(begin, middle, end)| R::MoveCCoords { begin, middle, end })
             .boxed(),
-        (pose(), pose())
+        K::MoveCCoordsFromHere => (pose(), pose())
             .prop_map(|(middle, end)| R::MoveCCoordsFromHere { middle, end })
             .boxed(),
-        (joint(), direction(), speed())
+        K::SolveIk => (pose(), deg6())
+            .prop_map(|(target, current)| R::SolveIk { target, current })
+            .boxed(),
+        K::GetAnglesCoords => Just(R::GetAnglesCoords).boxed(),
+        K::GetPlannedAngles => Just(R::GetPlannedAngles).boxed(),
+        K::GetPlannedCoords => Just(R::GetPlannedCoords).boxed(),
+        K::MoveRound => Just(R::MoveRound).boxed(),
+        K::SetFourPiecesZero => Just(R::SetFourPiecesZero).boxed(),
+        // --- jog ---
+        K::JogAngle => (joint(), direction(), speed())
             .prop_map(|(joint, direction, speed)| R::JogAngle {
                 joint,
                 direction,
                 speed,
             })
             .boxed(),
-        (1u8..=3, direction(), speed())
+        K::JogRpy => (1u8..=3, direction(), speed())
             .prop_map(|(a, direction, speed)| R::JogRpy {
                 axis: RpyAxis::from_u8(a).unwrap(),
                 direction,
                 speed,
             })
             .boxed(),
-        (axis(), direction(), speed())
+        K::JogCoord => (axis(), direction(), speed())
             .prop_map(|(axis, direction, speed)| R::JogCoord {
                 axis,
                 direction,
                 speed,
             })
             .boxed(),
-        (joint(), any::<i16>(), speed())
+        K::JogIncrementAngle => (joint(), any::<i16>(), speed())
             .prop_map(|(joint, i, speed)| R::JogIncrementAngle {
                 joint,
                 increment: Centideg(i),
                 speed,
             })
             .boxed(),
-        (axis_value(), speed())
+        K::JogStop => Just(R::JogStop).boxed(),
+        K::JogIncrementCoord => (axis_value(), speed())
             .prop_map(|(increment, speed)| R::JogIncrementCoord { increment, speed })
             .boxed(),
-        (servo(), encoder(), prop::option::of(speed()))
+        // --- encoders, speed, limits ---
+        K::SetEncoder => (servo(), encoder(), prop::option::of(speed()))
             .prop_map(|(servo, encoder, speed)| R::SetEncoder {
                 servo,
                 encoder,
                 speed,
             })
             .boxed(),
-        servo().prop_map(|servo| R::GetEncoder { servo }).boxed(),
-        (encoders(), speed())
+        K::GetEncoder => servo().prop_map(|servo| R::GetEncoder { servo }).boxed(),
+        K::SetEncoders => (encoders(), speed())
             .prop_map(|(encoders, speed)| R::SetEncoders { encoders, speed })
             .boxed(),
-        (encoders(), prop::array::uniform6(0i16..=6000))
+        K::GetEncoders => Just(R::GetEncoders).boxed(),
+        K::SetEncodersDrag => (encoders(), prop::array::uniform6(0i16..=6000))
             .prop_map(|(encoders, s)| R::SetEncodersDrag {
                 encoders,
                 speeds_steps_per_s: s,
             })
             .boxed(),
-        speed().prop_map(|speed| R::SetSpeed { speed }).boxed(),
-        joint().prop_map(|joint| R::GetJointMin { joint }).boxed(),
-        joint().prop_map(|joint| R::GetJointMax { joint }).boxed(),
-        (joint(), any::<i16>())
+        K::GetSpeed => Just(R::GetSpeed).boxed(),
+        K::SetSpeed => speed().prop_map(|speed| R::SetSpeed { speed }).boxed(),
+        K::GetJointMin => joint().prop_map(|joint| R::GetJointMin { joint }).boxed(),
+        K::GetJointMax => joint().prop_map(|joint| R::GetJointMax { joint }).boxed(),
+        K::SetJointMin => (joint(), any::<i16>())
             .prop_map(|(joint, l)| R::SetJointMin {
                 joint,
                 limit: Decideg(l),
             })
             .boxed(),
-        (joint(), any::<i16>())
+        K::SetJointMax => (joint(), any::<i16>())
             .prop_map(|(joint, l)| R::SetJointMax {
                 joint,
                 limit: Decideg(l),
             })
             .boxed(),
-        servo()
+        // --- servos ---
+        K::IsServoEnabled => servo()
             .prop_map(|servo| R::IsServoEnabled { servo })
             .boxed(),
-        (
+        K::AreAllServosEnabled => Just(R::AreAllServosEnabled).boxed(),
+        K::SetServoData => (
             servo(),
             5u8..,
             prop_oneof![
@@ -220,7 +248,7 @@ fn request_strategies() -> Vec<BoxedStrategy<Request>> {
                 value,
             })
             .boxed(),
-        (
+        K::GetServoData => (
             servo(),
             any::<u8>(),
             prop::option::of(prop_oneof![Just(DataWidth::Byte), Just(DataWidth::Word)]),
@@ -231,23 +259,29 @@ fn request_strategies() -> Vec<BoxedStrategy<Request>> {
                 width,
             })
             .boxed(),
-        servo()
+        K::SetServoCalibration => servo()
             .prop_map(|servo| R::SetServoCalibration { servo })
             .boxed(),
-        servo().prop_map(|servo| R::JointBrake { servo }).boxed(),
-        (servo(), prop::option::of(any::<bool>()))
+        K::JointBrake => servo().prop_map(|servo| R::JointBrake { servo }).boxed(),
+        K::ReleaseServo => (servo(), prop::option::of(any::<bool>()))
             .prop_map(|(servo, undamped)| R::ReleaseServo { servo, undamped })
             .boxed(),
-        select(ServoSelect::All)
+        K::FocusServo => select(ServoSelect::All)
             .prop_map(|servo| R::FocusServo { servo })
             .boxed(),
-        select(ServoSelect::All)
+        K::GetServoSpeeds => Just(R::GetServoSpeeds).boxed(),
+        K::GetServoCurrents => Just(R::GetServoCurrents).boxed(),
+        K::GetServoVoltages => Just(R::GetServoVoltages).boxed(),
+        K::GetServoStatus => Just(R::GetServoStatus).boxed(),
+        K::GetServoTemps => Just(R::GetServoTemps).boxed(),
+        K::BackupServoParams => select(ServoSelect::All)
             .prop_map(|servo| R::BackupServoParams { servo })
             .boxed(),
-        select(ServoSelect::All)
+        K::RestoreServoParams => select(ServoSelect::All)
             .prop_map(|servo| R::RestoreServoParams { servo })
             .boxed(),
-        prop_oneof![
+        // --- Atom IO, LED, gripper ---
+        K::SetPinMode => prop_oneof![
             (
                 atom_pin(),
                 prop_oneof![Just(PinMode::Input), Just(PinMode::InputPullUp)]
@@ -256,90 +290,113 @@ fn request_strategies() -> Vec<BoxedStrategy<Request>> {
         ]
         .prop_map(|(pin, mode)| R::SetPinMode { pin, mode })
         .boxed(),
-        (atom_output_pin(), any::<bool>())
+        K::SetDigitalOutput => (atom_output_pin(), any::<bool>())
             .prop_map(|(pin, high)| R::SetDigitalOutput { pin, high })
             .boxed(),
-        atom_pin()
+        K::GetDigitalInput => atom_pin()
             .prop_map(|pin| R::GetDigitalInput { pin })
             .boxed(),
-        (atom_output_pin(), any::<u16>(), any::<u8>())
+        K::SetPwmOutput => (atom_output_pin(), any::<u16>(), any::<u8>())
             .prop_map(|(pin, frequency_hz, duty)| R::SetPwmOutput {
                 pin,
                 frequency_hz,
                 duty,
             })
             .boxed(),
-        prop::option::of(gripper_type())
+        K::GetGripperValue => prop::option::of(gripper_type())
             .prop_map(|gripper| R::GetGripperValue { gripper })
             .boxed(),
-        gripper_state()
+        K::SetGripperStateNoSpeed => gripper_state()
             .prop_map(|state| R::SetGripperStateNoSpeed { state })
             .boxed(),
-        (gripper_state(), gripper_speed(), gripper_model())
+        K::SetGripperState => (gripper_state(), gripper_speed(), gripper_model())
             .prop_map(|(state, speed, model)| R::SetGripperState {
                 state,
                 speed,
                 model,
             })
             .boxed(),
-        (0u8..=100, gripper_speed(), gripper_model())
+        K::SetGripperValue => (0u8..=100, gripper_speed(), gripper_model())
             .prop_map(|(v, speed, model)| R::SetGripperValue {
                 value: GripperValue::new(v).unwrap(),
                 speed,
                 model,
             })
             .boxed(),
-        (any::<u8>(), any::<u8>(), any::<u8>())
+        K::SetGripperCalibration => Just(R::SetGripperCalibration).boxed(),
+        K::IsGripperMoving => Just(R::IsGripperMoving).boxed(),
+        K::SetColor => (any::<u8>(), any::<u8>(), any::<u8>())
             .prop_map(|(r, g, b)| R::SetColor {
                 rgb: Rgb { r, g, b },
             })
             .boxed(),
-        (150i16..=980)
+        K::SetHtsGripperTorque => (150i16..=980)
             .prop_map(|torque| R::SetHtsGripperTorque { torque })
             .boxed(),
-        (1i16..=500)
+        K::GetHtsGripperTorque => Just(R::GetHtsGripperTorque).boxed(),
+        K::GetGripperProtectCurrent => Just(R::GetGripperProtectCurrent).boxed(),
+        K::InitGripper => Just(R::InitGripper).boxed(),
+        K::SetGripperProtectCurrent => (1i16..=500)
             .prop_map(|current| R::SetGripperProtectCurrent { current })
             .boxed(),
-        pose().prop_map(|pose| R::SetToolReference { pose }).boxed(),
-        pose()
+        // --- coordinate frames ---
+        K::SetToolReference => pose().prop_map(|pose| R::SetToolReference { pose }).boxed(),
+        K::GetToolReference => Just(R::GetToolReference).boxed(),
+        K::SetWorldReference => pose()
             .prop_map(|pose| R::SetWorldReference { pose })
             .boxed(),
-        prop_oneof![Just(ReferenceFrame::Base), Just(ReferenceFrame::World)]
-            .prop_map(|frame| R::SetReferenceFrame { frame })
-            .boxed(),
-        prop_oneof![Just(MoveMode::Joint), Just(MoveMode::Linear)]
+        K::GetWorldReference => Just(R::GetWorldReference).boxed(),
+        K::SetReferenceFrame => {
+            prop_oneof![Just(ReferenceFrame::Base), Just(ReferenceFrame::World)]
+                .prop_map(|frame| R::SetReferenceFrame { frame })
+                .boxed()
+        }
+        K::GetReferenceFrame => Just(R::GetReferenceFrame).boxed(),
+        K::SetMovementType => prop_oneof![Just(MoveMode::Joint), Just(MoveMode::Linear)]
             .prop_map(|mode| R::SetMovementType { mode })
             .boxed(),
-        prop_oneof![Just(EndType::Flange), Just(EndType::Tool)]
+        K::GetMovementType => Just(R::GetMovementType).boxed(),
+        K::SetEndType => prop_oneof![Just(EndType::Flange), Just(EndType::Tool)]
             .prop_map(|end| R::SetEndType { end })
             .boxed(),
-        (prop::sample::select(vec![2u8, 5]), any::<bool>())
+        K::GetEndType => Just(R::GetEndType).boxed(),
+        // --- answered by the Basic ---
+        K::SetBasicOutput => (prop::sample::select(vec![2u8, 5]), any::<bool>())
             .prop_map(|(p, high)| R::SetBasicOutput {
                 pin: BasicOutputPin::new(p).unwrap(),
                 high,
             })
             .boxed(),
-        prop::sample::select(vec![35u8, 36])
+        K::GetBasicInput => prop::sample::select(vec![35u8, 36])
             .prop_map(|p| R::GetBasicInput {
                 pin: BasicInputPin::new(p).unwrap(),
             })
             .boxed(),
-        prop::collection::vec(any::<u8>(), 0..=62)
+        K::SetSsidPwd => prop::collection::vec(any::<u8>(), 0..=62)
             .prop_map(|v| R::SetSsidPwd {
                 payload: heapless::Vec::from_slice(&v).unwrap(),
             })
             .boxed(),
-        any::<u16>()
+        K::GetSsidPwd => Just(R::GetSsidPwd).boxed(),
+        K::SetServerPort => any::<u16>()
             .prop_map(|port| R::SetServerPort { port })
             .boxed(),
-        prop_oneof![
+        K::GetTofDistance => Just(R::GetTofDistance).boxed(),
+        K::GetBasicVersion => Just(R::GetBasicVersion).boxed(),
+        K::SetTransponderMode => prop_oneof![
             Just(TransponderMode::Framed),
             Just(TransponderMode::Transparent)
         ]
         .prop_map(|mode| R::SetTransponderMode { mode })
         .boxed(),
-    ]);
-    all
+        K::GetTransponderMode => Just(R::GetTransponderMode).boxed(),
+        // --- drag teaching ---
+        K::DragStartRecord => Just(R::DragStartRecord).boxed(),
+        K::DragEndRecord => Just(R::DragEndRecord).boxed(),
+        K::DragGetRecordData => Just(R::DragGetRecordData).boxed(),
+        K::DragGetRecordLen => Just(R::DragGetRecordLen).boxed(),
+        K::DragClearRecordData => Just(R::DragClearRecordData).boxed(),
+    }
 }
 
 fn gripper_state() -> impl Strategy<Value = GripperState> {
@@ -350,8 +407,9 @@ fn gripper_state() -> impl Strategy<Value = GripperState> {
     ]
 }
 
+/// Any request: every kind of [`RequestKind::ALL`], equally likely.
 fn request() -> impl Strategy<Value = Request> {
-    Union::new(request_strategies())
+    Union::new(RequestKind::ALL.iter().map(|&kind| request_of(kind)))
 }
 
 fn reply() -> impl Strategy<Value = Reply> {
@@ -572,17 +630,43 @@ proptest! {
     }
 }
 
+/// Every kind's strategy draws requests of that kind (so no kind is drawn in another's
+/// place), and together they draw every layout of every command code.
 #[test]
-fn request_strategies_cover_every_command() {
+fn request_strategies_cover_every_kind_and_command() {
     use proptest::strategy::ValueTree;
     use proptest::test_runner::TestRunner;
     let mut runner = TestRunner::deterministic();
     let mut codes = std::collections::BTreeSet::new();
-    for s in request_strategies() {
+    let mut kinds = std::collections::BTreeSet::new();
+    for &kind in RequestKind::ALL {
         for _ in 0..64 {
-            codes.insert(s.new_tree(&mut runner).unwrap().current().cmd());
+            let req = request_of(kind).new_tree(&mut runner).unwrap().current();
+            assert_eq!(req.kind(), kind, "{req:?} drawn for {kind:?}");
+            codes.insert(req.cmd());
+            kinds.insert(format!("{kind:?}"));
         }
     }
+    assert_eq!(kinds.len(), RequestKind::ALL.len(), "a kind listed twice");
     let all: std::collections::BTreeSet<u8> = cmd::ALL.into_iter().collect();
     assert_eq!(codes, all);
+}
+
+/// The reply strategy draws every kind of reply.
+#[test]
+fn reply_strategy_covers_every_kind() {
+    use proptest::strategy::ValueTree;
+    use proptest::test_runner::TestRunner;
+    let mut runner = TestRunner::deterministic();
+    let strategy = reply();
+    let mut kinds = std::collections::BTreeSet::new();
+    for _ in 0..2000 {
+        kinds.insert(format!(
+            "{:?}",
+            strategy.new_tree(&mut runner).unwrap().current().kind()
+        ));
+    }
+    let all: std::collections::BTreeSet<String> =
+        ReplyKind::ALL.iter().map(|k| format!("{k:?}")).collect();
+    assert_eq!(kinds, all);
 }

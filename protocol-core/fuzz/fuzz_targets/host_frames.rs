@@ -9,23 +9,6 @@ use libfuzzer_sys::fuzz_target;
 use protocol_core::command::{Reply, ReplyKind, Request};
 use protocol_core::{Frame, FrameDecoder};
 
-const KINDS: [ReplyKind; 14] = [
-    ReplyKind::Ack,
-    ReplyKind::Byte,
-    ReplyKind::Int16,
-    ReplyKind::Angles,
-    ReplyKind::Coords,
-    ReplyKind::Encoders,
-    ReplyKind::Int16x6,
-    ReplyKind::Bytes6,
-    ReplyKind::ServoErrors,
-    ReplyKind::AnglesAndCoords,
-    ReplyKind::PinLevel,
-    ReplyKind::JointLimit,
-    ReplyKind::ServoEnabled,
-    ReplyKind::Raw,
-];
-
 fuzz_target!(|data: &[u8]| {
     let Some((&control, wire)) = data.split_first() else {
         return;
@@ -56,7 +39,7 @@ fuzz_target!(|data: &[u8]| {
             assert_eq!(&request.to_frame(), frame);
             let _ = request.reply_kind();
         }
-        for kind in KINDS {
+        for &kind in ReplyKind::ALL {
             if let Ok(reply) = Reply::parse(kind, frame) {
                 assert_eq!(&reply.to_frame(frame.cmd()), frame);
             }

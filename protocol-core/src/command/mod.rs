@@ -3,7 +3,9 @@
 //! * [`cmd`]: the command codes.
 //! * [`Request`]: a typed, validated command, parsed from a [`Frame`](crate::Frame) with
 //!   [`Request::parse`] and written back with [`Request::to_frame`]. Layouts of one command
-//!   are told apart by LEN.
+//!   are told apart by LEN. Every command is one entry of the table in `request.rs`: its
+//!   code, layouts, parse, emit and reply kind side by side. [`RequestKind`] names a
+//!   request's command without its fields ([`RequestKind::ALL`] lists them all).
 //! * [`Reply`]: a typed answer, written with [`Reply::to_frame`] and read back (by a client or
 //!   a test) with [`Reply::parse`] given the [`ReplyKind`] its request expects.
 //! * [`CommandError`], [`ErrorCode`], [`ServoErrorCode`]: what went wrong, on the wire.
@@ -40,7 +42,7 @@ mod wire;
 
 pub use error::{CommandError, ErrorCode, ServoErrorCode};
 pub use reply::{DragPoint, Reply, ReplyError, ReplyKind};
-pub use request::{MAX_DRAG_SPEED, Request};
+pub use request::{MAX_DRAG_SPEED, Request, RequestKind};
 pub use types::{
     AtomPin, Axis, AxisValue, BasicInputPin, BasicOutputPin, DataWidth, Direction, EndType,
     GripperModel, GripperSpeed, GripperState, GripperType, GripperValue, JointId, MoveMode,

@@ -75,38 +75,41 @@ pub struct DragPoint {
     pub speeds_steps_per_s: [i16; 6],
 }
 
-/// The shape of reply a request expects ([`Request::reply_kind`](super::Request::reply_kind)).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ReplyKind {
-    /// [`Reply::Ack`].
+/// Declares [`ReplyKind`] and [`ReplyKind::ALL`] from one list, so the list cannot miss a kind.
+macro_rules! reply_kinds {
+    ($($kind:ident),* $(,)?) => {
+        /// The shape of reply a request expects
+        /// ([`Request::reply_kind`](super::Request::reply_kind)).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum ReplyKind {
+            $(
+                #[doc = concat!("[`Reply::", stringify!($kind), "`].")]
+                $kind,
+            )*
+        }
+
+        impl ReplyKind {
+            /// Every kind, in declaration order.
+            pub const ALL: &'static [Self] = &[$(Self::$kind),*];
+        }
+    };
+}
+
+reply_kinds! {
     Ack,
-    /// [`Reply::Byte`].
     Byte,
-    /// [`Reply::Int16`].
     Int16,
-    /// [`Reply::Angles`].
     Angles,
-    /// [`Reply::Coords`].
     Coords,
-    /// [`Reply::Encoders`].
     Encoders,
-    /// [`Reply::Int16x6`].
     Int16x6,
-    /// [`Reply::Bytes6`].
     Bytes6,
-    /// [`Reply::ServoErrors`].
     ServoErrors,
-    /// [`Reply::AnglesAndCoords`].
     AnglesAndCoords,
-    /// [`Reply::PinLevel`].
     PinLevel,
-    /// [`Reply::JointLimit`].
     JointLimit,
-    /// [`Reply::ServoEnabled`].
     ServoEnabled,
-    /// [`Reply::DragPoint`].
     DragPoint,
-    /// [`Reply::Raw`].
     Raw,
 }
 

@@ -1,4 +1,9 @@
 //! [`Request`]: every host command as a typed, validated value.
+//!
+//! The commands are one table (the `requests!` invocation below, the macro in
+//! `request/table.rs`): each entry holds one command's doc, fields, code, reply kind, layout
+//! (data length), parse and emit, so everything about a command is in one place and a new
+//! command is one new entry, which every match over [`Request`] then handles.
 
 use heapless::Vec;
 
@@ -14,7 +19,13 @@ use super::types::{
     PinMode, Pose, PositionTarget, ReferenceFrame, Rgb, RpyAxis, ServoId, ServoSelect, ServoValue,
     TransponderMode,
 };
-use super::wire::{Reader, Writer};
+use super::wire::Writer;
+
+mod fields;
+mod table;
+
+use fields::Fields;
+use table::requests;
 
 /// Highest encoder value a client may send (pymycobot allows 0..=4096).
 pub const MAX_ENCODER: i16 = 4096;
@@ -29,737 +40,776 @@ pub const PROTECT_CURRENT_RANGE: core::ops::RangeInclusive<i16> = 1..=500;
 /// register 1 of servo 7).
 pub const MIN_SERVO_ADDRESS: u8 = 5;
 
-/// One host command, typed and validated: every field holds a value the protocol allows.
-///
-/// Parse with [`Request::parse`], write with [`Request::to_frame`]. Variants follow
-/// `protocol.md` section 5; each doc names the code and, where a command has several layouts,
-/// the LEN of this one.
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
-pub enum Request {
-    // --- status and system ---
-    /// 0x01 get modify version.
-    GetModifyVersion,
-    /// 0x02 get system version.
-    GetSystemVersion,
-    /// 0x05 clear queue.
-    ClearQueue,
-    /// 0x06 check async or sync.
-    CheckAsyncOrSync,
-    /// 0x07 get error information.
-    GetErrorInfo,
-    /// 0x08 clear error information.
-    ClearErrorInfo,
-    /// 0x10 power on.
-    PowerOn,
-    /// 0x11 power off.
-    PowerOff,
-    /// 0x12 is powered on.
-    IsPowerOn,
-    /// 0x13 release all servos. `undamped`: `None` for LEN 2, else the flag byte of LEN 3
-    /// (1 = undamped, 0 = damped).
-    ReleaseAllServos {
-        /// Optional undamped flag.
-        undamped: Option<bool>,
-    },
-    /// 0x14 is controller connected.
-    IsControllerConnected,
-    /// 0x15 read next error.
-    ReadNextError,
-    /// 0x16 set fresh mode.
-    SetFreshMode {
-        /// True: the newest command preempts; false: commands queue.
-        fresh: bool,
-    },
-    /// 0x17 get fresh mode.
-    GetFreshMode,
-    /// 0x1A set free mode.
-    SetFreeMode {
-        /// Free mode on.
-        on: bool,
-    },
-    /// 0x1B is free mode.
-    IsFreeMode,
-    /// 0x1D set vision mode.
-    SetVisionMode {
-        /// Vision mode on.
-        on: bool,
-    },
-    /// 0xD8 get reboot count.
-    GetRebootCount,
+requests! {
+    /// One host command, typed and validated: every field holds a value the protocol allows.
+    ///
+    /// Parse with [`Request::parse`], write with [`Request::to_frame`]. Variants follow
+    /// `protocol.md` section 5; each doc names the code and, where a command has several
+    /// layouts, the LEN of this one.
+    #[derive(Clone, Debug, PartialEq, Eq, Hash)]
+    pub enum Request {
+        // --- status and system ---
 
-    // --- motion ---
-    /// 0x20 get angles.
-    GetAngles,
-    /// 0x21 send one joint angle.
-    SendAngle {
-        /// Joint.
-        joint: JointId,
-        /// Target angle.
-        angle: Centideg,
-        /// Speed.
-        speed: SpeedPercent,
-    },
-    /// 0x22 send six joint angles.
-    SendAngles {
-        /// Target angles, joints 1..6.
-        angles: [Centideg; 6],
-        /// Speed.
-        speed: SpeedPercent,
-    },
-    /// 0x23 (LEN 2) get coords.
-    GetCoords,
-    /// 0x23 (LEN 0x0E) angles to coords: forward kinematics, no motion.
-    AnglesToCoords {
-        /// Joint angles.
-        angles: [Centideg; 6],
-    },
-    /// 0x24 send one coordinate.
-    SendCoord {
-        /// Axis and target value.
-        target: AxisValue,
-        /// Speed.
-        speed: SpeedPercent,
-    },
-    /// 0x25 send a pose: LEN 0x0F without mode, LEN 0x10 with mode.
-    SendCoords {
-        /// Target pose.
-        pose: Pose,
-        /// Speed.
-        speed: SpeedPercent,
-        /// Interpolation; `None` when the client sent no mode byte.
-        mode: Option<MoveMode>,
-    },
-    /// 0x26 pause.
-    Pause,
-    /// 0x27 is paused.
-    IsPaused,
-    /// 0x28 resume.
-    Resume,
-    /// 0x29 stop.
-    Stop,
-    /// 0x2A is in position.
-    IsInPosition {
-        /// Angles (flag 0) or coords (flag 1).
-        target: PositionTarget,
-    },
-    /// 0x2B is moving.
-    IsMoving,
-    /// 0x2C (LEN 8, MyCobotBasic `setPid`) set the servos' position-loop gains: P, I, D of
-    /// joints 1..3, then P, I, D of joints 4..6, one byte each.
-    SetPid {
-        /// P, I, D of joints 1..3, then of joints 4..6.
-        gains: [u8; 6],
-    },
-    /// 0x2D (MyCobotBasic `getPid`) get the gains as 0x2C sets them.
-    GetPid,
-    /// 0x8B (LEN 38, MyCobotBasic `moveCCoords(begin, middle, end)`) go to `begin`, then along
-    /// the circle through `begin`, `middle` and `end` to `end`, at the default speed (0x41).
-    MoveCCoords {
-        /// Where the arc starts.
-        begin: Pose,
-        /// A pose the arc passes through.
-        middle: Pose,
-        /// Where the arc ends.
-        end: Pose,
-    },
-    /// 0x8C (LEN 26, MyCobotBasic `moveCCoords(middle, end)`) along the circle through the
-    /// present pose, `middle` and `end` to `end`, at the default speed (0x41).
-    MoveCCoordsFromHere {
-        /// A pose the arc passes through.
-        middle: Pose,
-        /// Where the arc ends.
-        end: Pose,
-    },
-    /// 0x8D solve inverse kinematics.
-    SolveIk {
-        /// Pose to reach.
-        target: Pose,
-        /// Current joint angles (the seed of the solution).
-        current: [Centideg; 6],
-    },
-    /// 0xD5 get angles and coords.
-    GetAnglesCoords,
-    /// 0xF6 get planned angles.
-    GetPlannedAngles,
-    /// 0xF7 get planned coords.
-    GetPlannedCoords,
-    /// 0xD4 move round (pymycobot `move_round`).
-    MoveRound,
-    /// 0xD7 set four pieces zero (pymycobot `set_four_pieces_zero`).
-    SetFourPiecesZero,
+        /// 0x01 get modify version.
+        GetModifyVersion = cmd::GET_MODIFY_VERSION, reply ReplyKind::Byte;
+        /// 0x02 get system version.
+        GetSystemVersion = cmd::GET_SYSTEM_VERSION, reply ReplyKind::Byte;
+        /// 0x05 clear queue.
+        ClearQueue = cmd::CLEAR_QUEUE, reply ReplyKind::Ack;
+        /// 0x06 check async or sync.
+        CheckAsyncOrSync = cmd::CHECK_ASYNC_OR_SYNC, reply ReplyKind::Byte;
+        /// 0x07 get error information.
+        GetErrorInfo = cmd::GET_ERROR_INFO, reply ReplyKind::Byte;
+        /// 0x08 clear error information.
+        ClearErrorInfo = cmd::CLEAR_ERROR_INFO, reply ReplyKind::Ack;
+        /// 0x10 power on.
+        PowerOn = cmd::POWER_ON, reply ReplyKind::Ack;
+        /// 0x11 power off.
+        PowerOff = cmd::POWER_OFF, reply ReplyKind::Ack;
+        /// 0x12 is powered on.
+        IsPowerOn = cmd::IS_POWER_ON, reply ReplyKind::Byte;
+        /// 0x13 release all servos. `undamped`: `None` for LEN 2, else the flag byte of LEN 3
+        /// (1 = undamped, 0 = damped).
+        ReleaseAllServos {
+            /// Optional undamped flag.
+            undamped: Option<bool>,
+        } = cmd::RELEASE_ALL_SERVOS, reply ReplyKind::Ack,
+        data 0 | 1 => |f| Self::ReleaseAllServos { undamped: f.optional(Fields::flag)? },
+        emit |w| {
+            if let Some(u) = undamped {
+                w.u8(u8::from(*u));
+            }
+        };
+        /// 0x14 is controller connected.
+        IsControllerConnected = cmd::IS_CONTROLLER_CONNECTED, reply ReplyKind::Byte;
+        /// 0x15 read next error.
+        ReadNextError = cmd::READ_NEXT_ERROR, reply ReplyKind::ServoErrors;
+        /// 0x16 set fresh mode.
+        SetFreshMode {
+            /// True: the newest command preempts; false: commands queue.
+            fresh: bool,
+        } = cmd::SET_FRESH_MODE, reply ReplyKind::Ack,
+        data 1 => |f| Self::SetFreshMode { fresh: f.flag()? },
+        emit |w| { w.u8(u8::from(*fresh)); };
+        /// 0x17 get fresh mode.
+        GetFreshMode = cmd::GET_FRESH_MODE, reply ReplyKind::Byte;
+        /// 0x1A set free mode.
+        SetFreeMode {
+            /// Free mode on.
+            on: bool,
+        } = cmd::SET_FREE_MODE, reply ReplyKind::Ack,
+        data 1 => |f| Self::SetFreeMode { on: f.flag()? },
+        emit |w| { w.u8(u8::from(*on)); };
+        /// 0x1B is free mode.
+        IsFreeMode = cmd::IS_FREE_MODE, reply ReplyKind::Byte;
+        /// 0x1D set vision mode.
+        SetVisionMode {
+            /// Vision mode on.
+            on: bool,
+        } = cmd::SET_VISION_MODE, reply ReplyKind::Ack,
+        data 1 => |f| Self::SetVisionMode { on: f.flag()? },
+        emit |w| { w.u8(u8::from(*on)); };
+        /// 0xD8 get reboot count.
+        GetRebootCount = cmd::GET_REBOOT_COUNT, reply ReplyKind::Int16;
 
-    // --- jog ---
-    /// 0x30 jog one joint until jog stop / stop.
-    JogAngle {
-        /// Joint.
-        joint: JointId,
-        /// Direction.
-        direction: Direction,
-        /// Speed.
-        speed: SpeedPercent,
-    },
-    /// 0x31 jog rotation about a base axis.
-    JogRpy {
-        /// Axis.
-        axis: RpyAxis,
-        /// Direction.
-        direction: Direction,
-        /// Speed.
-        speed: SpeedPercent,
-    },
-    /// 0x32 jog along / about a Cartesian axis.
-    JogCoord {
-        /// Axis.
-        axis: Axis,
-        /// Direction.
-        direction: Direction,
-        /// Speed.
-        speed: SpeedPercent,
-    },
-    /// 0x33 jog one joint by an increment.
-    JogIncrementAngle {
-        /// Joint.
-        joint: JointId,
-        /// Increment.
-        increment: Centideg,
-        /// Speed.
-        speed: SpeedPercent,
-    },
-    /// 0x34 (LEN 2) jog stop.
-    JogStop,
-    /// 0x34 (LEN 6) jog increment coord.
-    JogIncrementCoord {
-        /// Axis and increment.
-        increment: AxisValue,
-        /// Speed.
-        speed: SpeedPercent,
-    },
+        // --- motion ---
 
-    // --- encoders, speed, limits ---
-    /// 0x3A set one servo's encoder: LEN 5 without speed (seed manual), LEN 6 with speed.
-    SetEncoder {
-        /// Servo 1..7.
-        servo: ServoId,
-        /// Target, 0..=4096.
-        encoder: Steps,
-        /// Speed; `None` for the LEN-5 form.
-        speed: Option<SpeedPercent>,
-    },
-    /// 0x3B get one servo's encoder.
-    GetEncoder {
-        /// Servo 1..7.
-        servo: ServoId,
-    },
-    /// 0x3C set six encoders.
-    SetEncoders {
-        /// Targets, 0..=4096 each.
-        encoders: [Steps; 6],
-        /// Speed.
-        speed: SpeedPercent,
-    },
-    /// 0x3D get six encoders.
-    GetEncoders,
-    /// 0x3E set six encoders with per-servo speeds.
-    SetEncodersDrag {
-        /// Targets, 0..=4096 each.
-        encoders: [Steps; 6],
-        /// Servo speeds, steps per second, 0..=6000 each.
-        speeds_steps_per_s: [i16; 6],
-    },
-    /// 0x40 get speed.
-    GetSpeed,
-    /// 0x41 set speed.
-    SetSpeed {
-        /// Default speed.
-        speed: SpeedPercent,
-    },
-    /// 0x4A get joint min limit.
-    GetJointMin {
-        /// Joint.
-        joint: JointId,
-    },
-    /// 0x4B get joint max limit.
-    GetJointMax {
-        /// Joint.
-        joint: JointId,
-    },
-    /// 0x4C set joint min limit.
-    SetJointMin {
-        /// Joint.
-        joint: JointId,
-        /// Limit (tenths of a degree on the wire).
-        limit: Decideg,
-    },
-    /// 0x4D set joint max limit.
-    SetJointMax {
-        /// Joint.
-        joint: JointId,
-        /// Limit (tenths of a degree on the wire).
-        limit: Decideg,
-    },
+        /// 0x20 get angles.
+        GetAngles = cmd::GET_ANGLES, reply ReplyKind::Angles;
+        /// 0x21 send one joint angle.
+        SendAngle {
+            /// Joint.
+            joint: JointId,
+            /// Target angle.
+            angle: Centideg,
+            /// Speed.
+            speed: SpeedPercent,
+        } = cmd::SEND_ANGLE, reply ReplyKind::Ack,
+        data 4 => |f| Self::SendAngle {
+            joint: f.joint()?,
+            angle: Centideg(f.i16()?),
+            speed: f.speed()?,
+        },
+        emit |w| { w.u8(joint.get()).i16(angle.0).u8(speed.get()); };
+        /// 0x22 send six joint angles.
+        SendAngles {
+            /// Target angles, joints 1..6.
+            angles: [Centideg; 6],
+            /// Speed.
+            speed: SpeedPercent,
+        } = cmd::SEND_ANGLES, reply ReplyKind::Ack,
+        data 13 => |f| Self::SendAngles { angles: f.centideg6()?, speed: f.speed()? },
+        emit |w| { w.centideg6(angles).u8(speed.get()); };
+        /// 0x23 (LEN 2) get coords.
+        GetCoords = cmd::GET_COORDS, reply ReplyKind::Coords;
+        /// 0x23 (LEN 0x0E) angles to coords: forward kinematics, no motion.
+        AnglesToCoords {
+            /// Joint angles.
+            angles: [Centideg; 6],
+        } = cmd::GET_COORDS, reply ReplyKind::Coords,
+        data 12 => |f| Self::AnglesToCoords { angles: f.centideg6()? },
+        emit |w| { w.centideg6(angles); };
+        /// 0x24 send one coordinate.
+        SendCoord {
+            /// Axis and target value.
+            target: AxisValue,
+            /// Speed.
+            speed: SpeedPercent,
+        } = cmd::SEND_COORD, reply ReplyKind::Ack,
+        data 4 => |f| Self::SendCoord { target: f.send_coord_axis_value()?, speed: f.speed()? },
+        emit |w| { w.u8(target.axis() as u8).i16(target.raw()).u8(speed.get()); };
+        /// 0x25 send a pose: LEN 0x0F without mode, LEN 0x10 with mode.
+        SendCoords {
+            /// Target pose.
+            pose: Pose,
+            /// Speed.
+            speed: SpeedPercent,
+            /// Interpolation; `None` when the client sent no mode byte.
+            mode: Option<MoveMode>,
+        } = cmd::SEND_COORDS, reply ReplyKind::Ack,
+        data 13 | 14 => |f| Self::SendCoords {
+            pose: f.pose()?,
+            speed: f.speed()?,
+            mode: f.optional(|f| f.enum_byte(MoveMode::from_u8))?,
+        },
+        emit |w| {
+            w.pose(pose).u8(speed.get());
+            if let Some(m) = mode {
+                w.u8(*m as u8);
+            }
+        };
+        /// 0x26 pause.
+        Pause = cmd::PAUSE, reply ReplyKind::Ack;
+        /// 0x27 is paused.
+        IsPaused = cmd::IS_PAUSED, reply ReplyKind::Byte;
+        /// 0x28 resume.
+        Resume = cmd::RESUME, reply ReplyKind::Ack;
+        /// 0x29 stop.
+        Stop = cmd::STOP, reply ReplyKind::Ack;
+        /// 0x2A is in position.
+        IsInPosition {
+            /// Angles (flag 0) or coords (flag 1).
+            target: PositionTarget,
+        } = cmd::IS_IN_POSITION, reply ReplyKind::Byte,
+        data 13 => |f| {
+            let values = f.i16x6()?;
+            Self::IsInPosition {
+                target: match f.flag()? {
+                    false => PositionTarget::Angles(values.map(Centideg)),
+                    true => PositionTarget::Coords(Pose::from_array(values)),
+                },
+            }
+        },
+        emit |w| {
+            match target {
+                PositionTarget::Angles(a) => w.centideg6(a).u8(0),
+                PositionTarget::Coords(p) => w.pose(p).u8(1),
+            };
+        };
+        /// 0x2B is moving.
+        IsMoving = cmd::IS_MOVING, reply ReplyKind::Byte;
+        /// 0x2C (LEN 8, MyCobotBasic `setPid`) set the servos' position-loop gains: P, I, D of
+        /// joints 1..3, then P, I, D of joints 4..6, one byte each.
+        SetPid {
+            /// P, I, D of joints 1..3, then of joints 4..6.
+            gains: [u8; 6],
+        } = cmd::SET_PID, reply ReplyKind::Ack,
+        data 6 => |f| Self::SetPid {
+            gains: [f.u8()?, f.u8()?, f.u8()?, f.u8()?, f.u8()?, f.u8()?],
+        },
+        emit |w| { w.bytes(gains); };
+        /// 0x2D (MyCobotBasic `getPid`) get the gains as 0x2C sets them.
+        GetPid = cmd::GET_PID, reply ReplyKind::Bytes6;
+        /// 0x8B (LEN 38, MyCobotBasic `moveCCoords(begin, middle, end)`) go to `begin`, then
+        /// along the circle through `begin`, `middle` and `end` to `end`, at the default speed
+        /// (0x41).
+        MoveCCoords {
+            /// Where the arc starts.
+            begin: Pose,
+            /// A pose the arc passes through.
+            middle: Pose,
+            /// Where the arc ends.
+            end: Pose,
+        } = cmd::MOVE_C_COORDS, reply ReplyKind::Ack,
+        data 36 => |f| Self::MoveCCoords { begin: f.pose()?, middle: f.pose()?, end: f.pose()? },
+        emit |w| { w.pose(begin).pose(middle).pose(end); };
+        /// 0x8C (LEN 26, MyCobotBasic `moveCCoords(middle, end)`) along the circle through the
+        /// present pose, `middle` and `end` to `end`, at the default speed (0x41).
+        MoveCCoordsFromHere {
+            /// A pose the arc passes through.
+            middle: Pose,
+            /// Where the arc ends.
+            end: Pose,
+        } = cmd::MOVE_C_COORDS_FROM_HERE, reply ReplyKind::Ack,
+        data 24 => |f| Self::MoveCCoordsFromHere { middle: f.pose()?, end: f.pose()? },
+        emit |w| { w.pose(middle).pose(end); };
+        /// 0x8D solve inverse kinematics.
+        SolveIk {
+            /// Pose to reach.
+            target: Pose,
+            /// Current joint angles (the seed of the solution).
+            current: [Centideg; 6],
+        } = cmd::SOLVE_INV_KINEMATICS, reply ReplyKind::Angles,
+        data 24 => |f| Self::SolveIk { target: f.pose()?, current: f.centideg6()? },
+        emit |w| { w.pose(target).centideg6(current); };
+        /// 0xD5 get angles and coords.
+        GetAnglesCoords = cmd::GET_ANGLES_COORDS, reply ReplyKind::AnglesAndCoords;
+        /// 0xF6 get planned angles.
+        GetPlannedAngles = cmd::GET_PLANNED_ANGLES, reply ReplyKind::Angles;
+        /// 0xF7 get planned coords.
+        GetPlannedCoords = cmd::GET_PLANNED_COORDS, reply ReplyKind::Coords;
+        /// 0xD4 move round (pymycobot `move_round`).
+        MoveRound = cmd::MOVE_ROUND, reply ReplyKind::Ack;
+        /// 0xD7 set four pieces zero (pymycobot `set_four_pieces_zero`).
+        SetFourPiecesZero = cmd::SET_FOUR_PIECES_ZERO, reply ReplyKind::Byte;
 
-    // --- servos ---
-    /// 0x50 is servo enabled.
-    IsServoEnabled {
-        /// Servo.
-        servo: ServoId,
-    },
-    /// 0x51 are all servos enabled.
-    AreAllServosEnabled,
-    /// 0x52 write a servo register: LEN 5 one byte; LEN 7 a 16-bit value and a width flag
-    /// (`01` two bytes, `00` one byte: the value must fit in it).
-    SetServoData {
-        /// Servo.
-        servo: ServoId,
-        /// Register address, >= 5.
-        address: u8,
-        /// Value.
-        value: ServoValue,
-    },
-    /// 0x53 read a servo register: LEN 4 (one byte) or LEN 5 with a width byte.
-    GetServoData {
-        /// Servo.
-        servo: ServoId,
-        /// Register address.
-        address: u8,
-        /// Width byte; `None` for the LEN-4 form (one byte).
-        width: Option<DataWidth>,
-    },
-    /// 0x54 make the servo's current position its zero.
-    SetServoCalibration {
-        /// Servo.
-        servo: ServoId,
-    },
-    /// 0x55 brake one joint.
-    JointBrake {
-        /// Servo.
-        servo: ServoId,
-    },
-    /// 0x56 release one servo: LEN 3, or LEN 4 with the undamped flag.
-    ReleaseServo {
-        /// Servo.
-        servo: ServoId,
-        /// Optional undamped flag.
-        undamped: Option<bool>,
-    },
-    /// 0x57 focus servo (torque on); wire 0 = all.
-    FocusServo {
-        /// Servo or all.
-        servo: ServoSelect,
-    },
-    /// 0xE1 get servo speeds.
-    GetServoSpeeds,
-    /// 0xE2 get servo currents.
-    GetServoCurrents,
-    /// 0xE3 get servo voltages.
-    GetServoVoltages,
-    /// 0xE4 get servo status.
-    GetServoStatus,
-    /// 0xE5 get servo temperatures.
-    GetServoTemps,
-    /// 0xEA back up servo parameters; wire 254 = all.
-    BackupServoParams {
-        /// Servo or all.
-        servo: ServoSelect,
-    },
-    /// 0xEB restore servo parameters; wire 254 = all.
-    RestoreServoParams {
-        /// Servo or all.
-        servo: ServoSelect,
-    },
+        // --- jog ---
 
-    // --- Atom IO, LED, gripper ---
-    /// 0x60 set an Atom pin's mode.
-    SetPinMode {
-        /// Pin.
-        pin: AtomPin,
-        /// Mode (pin 39 is input only).
-        mode: PinMode,
-    },
-    /// 0x61 set an Atom digital output.
-    SetDigitalOutput {
-        /// Pin (never 39).
-        pin: AtomPin,
-        /// High.
-        high: bool,
-    },
-    /// 0x62 get an Atom digital input.
-    GetDigitalInput {
-        /// Pin.
-        pin: AtomPin,
-    },
-    /// 0x64 set an Atom PWM output.
-    SetPwmOutput {
-        /// Pin (never 39).
-        pin: AtomPin,
-        /// Frequency, hertz.
-        frequency_hz: u16,
-        /// Duty, 0..=255 of full scale.
-        duty: u8,
-    },
-    /// 0x65 get gripper value: LEN 2, or LEN 3 with a gripper type.
-    GetGripperValue {
-        /// Gripper type, if given.
-        gripper: Option<GripperType>,
-    },
-    /// 0x66 (LEN 3, seed manual) set gripper state with no speed.
-    SetGripperStateNoSpeed {
-        /// State.
-        state: GripperState,
-    },
-    /// 0x66 set gripper state: LEN 4, 5 (type) or 6 (type, torque).
-    SetGripperState {
-        /// State.
-        state: GripperState,
-        /// Speed.
-        speed: GripperSpeed,
-        /// Optional type / torque tail.
-        model: GripperModel,
-    },
-    /// 0x67 set gripper opening: LEN 4, 5 (type) or 6 (type, torque).
-    SetGripperValue {
-        /// Opening.
-        value: GripperValue,
-        /// Speed.
-        speed: GripperSpeed,
-        /// Optional type / torque tail.
-        model: GripperModel,
-    },
-    /// 0x68 calibrate the gripper.
-    SetGripperCalibration,
-    /// 0x69 is gripper moving.
-    IsGripperMoving,
-    /// 0x6A set the Atom LED colour.
-    SetColor {
-        /// Colour.
-        rgb: Rgb,
-    },
-    /// 0x35 set HTS gripper torque, 150..=980.
-    SetHtsGripperTorque {
-        /// Torque.
-        torque: i16,
-    },
-    /// 0x36 get HTS gripper torque.
-    GetHtsGripperTorque,
-    /// 0x37 get gripper protect current.
-    GetGripperProtectCurrent,
-    /// 0x38 init gripper.
-    InitGripper,
-    /// 0x39 set gripper protect current, 1..=500.
-    SetGripperProtectCurrent {
-        /// Current.
-        current: i16,
-    },
+        /// 0x30 jog one joint until jog stop / stop.
+        JogAngle {
+            /// Joint.
+            joint: JointId,
+            /// Direction.
+            direction: Direction,
+            /// Speed.
+            speed: SpeedPercent,
+        } = cmd::JOG_ANGLE, reply ReplyKind::Ack,
+        data 3 => |f| Self::JogAngle {
+            joint: f.joint()?,
+            direction: f.direction()?,
+            speed: f.speed()?,
+        },
+        emit |w| { w.u8(joint.get()).u8(*direction as u8).u8(speed.get()); };
+        /// 0x31 jog rotation about a base axis.
+        JogRpy {
+            /// Axis.
+            axis: RpyAxis,
+            /// Direction.
+            direction: Direction,
+            /// Speed.
+            speed: SpeedPercent,
+        } = cmd::JOG_RPY, reply ReplyKind::Ack,
+        data 3 => |f| Self::JogRpy {
+            axis: f.rpy_axis()?,
+            direction: f.direction()?,
+            speed: f.speed()?,
+        },
+        emit |w| { w.u8(*axis as u8).u8(*direction as u8).u8(speed.get()); };
+        /// 0x32 jog along / about a Cartesian axis.
+        JogCoord {
+            /// Axis.
+            axis: Axis,
+            /// Direction.
+            direction: Direction,
+            /// Speed.
+            speed: SpeedPercent,
+        } = cmd::JOG_COORD, reply ReplyKind::Ack,
+        data 3 => |f| Self::JogCoord {
+            axis: f.axis()?,
+            direction: f.direction()?,
+            speed: f.speed()?,
+        },
+        emit |w| { w.u8(*axis as u8).u8(*direction as u8).u8(speed.get()); };
+        /// 0x33 jog one joint by an increment.
+        JogIncrementAngle {
+            /// Joint.
+            joint: JointId,
+            /// Increment.
+            increment: Centideg,
+            /// Speed.
+            speed: SpeedPercent,
+        } = cmd::JOG_INCREMENT_ANGLE, reply ReplyKind::Ack,
+        data 4 => |f| Self::JogIncrementAngle {
+            joint: f.joint()?,
+            increment: Centideg(f.i16()?),
+            speed: f.speed()?,
+        },
+        emit |w| { w.u8(joint.get()).i16(increment.0).u8(speed.get()); };
+        /// 0x34 (LEN 2) jog stop.
+        JogStop = cmd::JOG_STOP, reply ReplyKind::Ack;
+        /// 0x34 (LEN 6) jog increment coord.
+        JogIncrementCoord {
+            /// Axis and increment.
+            increment: AxisValue,
+            /// Speed.
+            speed: SpeedPercent,
+        } = cmd::JOG_INCREMENT_COORD, reply ReplyKind::Ack,
+        data 4 => |f| Self::JogIncrementCoord { increment: f.axis_value()?, speed: f.speed()? },
+        emit |w| { w.u8(increment.axis() as u8).i16(increment.raw()).u8(speed.get()); };
 
-    // --- coordinate frames ---
-    /// 0x81 set tool reference.
-    SetToolReference {
-        /// Tool pose in the flange frame.
-        pose: Pose,
-    },
-    /// 0x82 get tool reference.
-    GetToolReference,
-    /// 0x83 set world reference.
-    SetWorldReference {
-        /// Base pose in the world frame.
-        pose: Pose,
-    },
-    /// 0x84 get world reference.
-    GetWorldReference,
-    /// 0x85 set reference frame.
-    SetReferenceFrame {
-        /// Frame.
-        frame: ReferenceFrame,
-    },
-    /// 0x86 get reference frame.
-    GetReferenceFrame,
-    /// 0x87 set movement type.
-    SetMovementType {
-        /// Type.
-        mode: MoveMode,
-    },
-    /// 0x88 get movement type.
-    GetMovementType,
-    /// 0x89 set end type.
-    SetEndType {
-        /// End.
-        end: EndType,
-    },
-    /// 0x8A get end type.
-    GetEndType,
+        // --- encoders, speed, limits ---
 
-    // --- answered by the Basic ---
-    /// 0xA0 set a Basic output.
-    SetBasicOutput {
-        /// Pin.
-        pin: BasicOutputPin,
-        /// High.
-        high: bool,
-    },
-    /// 0xA1 get a Basic input.
-    GetBasicInput {
-        /// Pin.
-        pin: BasicInputPin,
-    },
-    /// 0xB0 set Wi-Fi SSID and password. pymycobot sends it empty (an announcing frame) and
-    /// the credentials 20 ms later as bare text `'ssid'(password)`, outside any frame; a
-    /// client may also frame that text here (`firmware_basic::wifi::config`).
-    SetSsidPwd {
-        /// Payload.
-        payload: Vec<u8, MAX_DATA>,
-    },
-    /// 0xB1 get Wi-Fi SSID and password.
-    GetSsidPwd,
-    /// 0xB2 set server port.
-    SetServerPort {
-        /// TCP port.
-        port: u16,
-    },
-    /// 0xC0 get ToF distance.
-    GetTofDistance,
-    /// 0xC1 get Basic version.
-    GetBasicVersion,
-    /// 0xC2 set transponder mode.
-    SetTransponderMode {
-        /// Mode.
-        mode: TransponderMode,
-    },
-    /// 0xC3 get transponder mode.
-    GetTransponderMode,
+        /// 0x3A set one servo's encoder: LEN 5 without speed (seed manual), LEN 6 with speed.
+        SetEncoder {
+            /// Servo 1..7.
+            servo: ServoId,
+            /// Target, 0..=4096.
+            encoder: Steps,
+            /// Speed; `None` for the LEN-5 form.
+            speed: Option<SpeedPercent>,
+        } = cmd::SET_ENCODER, reply ReplyKind::Ack,
+        data 3 | 4 => |f| Self::SetEncoder {
+            servo: f.servo()?,
+            encoder: f.encoder()?,
+            speed: f.optional(Fields::speed)?,
+        },
+        emit |w| {
+            w.u8(servo.get()).i16(encoder.0);
+            if let Some(s) = speed {
+                w.u8(s.get());
+            }
+        };
+        /// 0x3B get one servo's encoder.
+        GetEncoder {
+            /// Servo 1..7.
+            servo: ServoId,
+        } = cmd::GET_ENCODER, reply ReplyKind::Int16,
+        data 1 => |f| Self::GetEncoder { servo: f.servo()? },
+        emit |w| { w.u8(servo.get()); };
+        /// 0x3C set six encoders.
+        SetEncoders {
+            /// Targets, 0..=4096 each.
+            encoders: [Steps; 6],
+            /// Speed.
+            speed: SpeedPercent,
+        } = cmd::SET_ENCODERS, reply ReplyKind::Ack,
+        data 13 => |f| Self::SetEncoders { encoders: f.encoders()?, speed: f.speed()? },
+        emit |w| { w.steps6(encoders).u8(speed.get()); };
+        /// 0x3D get six encoders.
+        GetEncoders = cmd::GET_ENCODERS, reply ReplyKind::Encoders;
+        /// 0x3E set six encoders with per-servo speeds.
+        SetEncodersDrag {
+            /// Targets, 0..=4096 each.
+            encoders: [Steps; 6],
+            /// Servo speeds, steps per second, 0..=6000 each.
+            speeds_steps_per_s: [i16; 6],
+        } = cmd::SET_ENCODERS_DRAG, reply ReplyKind::Ack,
+        data 24 => |f| Self::SetEncodersDrag {
+            encoders: f.encoders()?,
+            speeds_steps_per_s: f.drag_speeds()?,
+        },
+        emit |w| { w.steps6(encoders).i16s(speeds_steps_per_s); };
+        /// 0x40 get speed.
+        GetSpeed = cmd::GET_SPEED, reply ReplyKind::Byte;
+        /// 0x41 set speed.
+        SetSpeed {
+            /// Default speed.
+            speed: SpeedPercent,
+        } = cmd::SET_SPEED, reply ReplyKind::Ack,
+        data 1 => |f| Self::SetSpeed { speed: f.speed()? },
+        emit |w| { w.u8(speed.get()); };
+        /// 0x4A get joint min limit.
+        GetJointMin {
+            /// Joint.
+            joint: JointId,
+        } = cmd::GET_JOINT_MIN, reply ReplyKind::JointLimit,
+        data 1 => |f| Self::GetJointMin { joint: f.joint()? },
+        emit |w| { w.u8(joint.get()); };
+        /// 0x4B get joint max limit.
+        GetJointMax {
+            /// Joint.
+            joint: JointId,
+        } = cmd::GET_JOINT_MAX, reply ReplyKind::JointLimit,
+        data 1 => |f| Self::GetJointMax { joint: f.joint()? },
+        emit |w| { w.u8(joint.get()); };
+        /// 0x4C set joint min limit.
+        SetJointMin {
+            /// Joint.
+            joint: JointId,
+            /// Limit (tenths of a degree on the wire).
+            limit: Decideg,
+        } = cmd::SET_JOINT_MIN, reply ReplyKind::Ack,
+        data 3 => |f| Self::SetJointMin { joint: f.joint()?, limit: Decideg(f.i16()?) },
+        emit |w| { w.u8(joint.get()).i16(limit.0); };
+        /// 0x4D set joint max limit.
+        SetJointMax {
+            /// Joint.
+            joint: JointId,
+            /// Limit (tenths of a degree on the wire).
+            limit: Decideg,
+        } = cmd::SET_JOINT_MAX, reply ReplyKind::Ack,
+        data 3 => |f| Self::SetJointMax { joint: f.joint()?, limit: Decideg(f.i16()?) },
+        emit |w| { w.u8(joint.get()).i16(limit.0); };
 
-    // --- drag teaching ---
-    /// 0xF1 start recording.
-    DragStartRecord,
-    /// 0xF2 end recording.
-    DragEndRecord,
-    /// 0xF3 get recorded data.
-    DragGetRecordData,
-    /// 0xF4 get record length.
-    DragGetRecordLen,
-    /// 0xF5 clear recorded data.
-    DragClearRecordData,
-}
+        // --- servos ---
 
-/// Generates the two directions of the mapping between data-less variants and their codes
-/// from one list, so they cannot drift apart.
-macro_rules! no_data_commands {
-    ($($variant:ident = $code:path),* $(,)?) => {
-        impl Request {
-            /// The data-less request for `code`, if that command has a LEN-2 layout.
-            fn from_no_data(code: u8) -> Option<Self> {
-                match code {
-                    $($code => Some(Self::$variant),)*
-                    _ => None,
+        /// 0x50 is servo enabled.
+        IsServoEnabled {
+            /// Servo.
+            servo: ServoId,
+        } = cmd::IS_SERVO_ENABLED, reply ReplyKind::ServoEnabled,
+        data 1 => |f| Self::IsServoEnabled { servo: f.servo()? },
+        emit |w| { w.u8(servo.get()); };
+        /// 0x51 are all servos enabled.
+        AreAllServosEnabled = cmd::ARE_ALL_SERVOS_ENABLED, reply ReplyKind::Byte;
+        /// 0x52 write a servo register: LEN 5 one byte; LEN 7 a 16-bit value and a width flag
+        /// (`01` two bytes, `00` one byte: the value must fit in it).
+        SetServoData {
+            /// Servo.
+            servo: ServoId,
+            /// Register address, >= 5.
+            address: u8,
+            /// Value.
+            value: ServoValue,
+        } = cmd::SET_SERVO_DATA, reply ReplyKind::Ack,
+        data 3 | 5 => |f| {
+            let servo = f.servo()?;
+            let address = f.address()?;
+            let value = if f.remaining() == 1 {
+                ServoValue::Byte(f.u8()?)
+            } else {
+                let word = f.i16()? as u16;
+                // pymycobot's `set_servo_data(.., mode)` always sends the value in two bytes
+                // and the flag says the register's width: 1 a word, 0 one byte (the low one).
+                match (f.u8()?, u8::try_from(word)) {
+                    (1, _) => ServoValue::Word(word),
+                    (0, Ok(byte)) => ServoValue::Byte(byte),
+                    (v, _) => return Err(CommandError::BadFlag(v)),
                 }
+            };
+            Self::SetServoData { servo, address, value }
+        },
+        emit |w| {
+            w.u8(servo.get()).u8(*address);
+            match value {
+                ServoValue::Byte(b) => w.u8(*b),
+                ServoValue::Word(v) => w.bytes(&v.to_be_bytes()).u8(1),
+            };
+        };
+        /// 0x53 read a servo register: LEN 4 (one byte) or LEN 5 with a width byte.
+        GetServoData {
+            /// Servo.
+            servo: ServoId,
+            /// Register address.
+            address: u8,
+            /// Width byte; `None` for the LEN-4 form (one byte).
+            width: Option<DataWidth>,
+        } = cmd::GET_SERVO_DATA,
+        reply match width {
+            Some(DataWidth::Word) => ReplyKind::Int16,
+            Some(DataWidth::Byte) | None => ReplyKind::Byte,
+        },
+        data 2 | 3 => |f| Self::GetServoData {
+            servo: f.servo()?,
+            address: f.u8()?,
+            width: f.optional(|f| f.enum_byte(DataWidth::from_u8))?,
+        },
+        emit |w| {
+            w.u8(servo.get()).u8(*address);
+            if let Some(wd) = width {
+                w.u8(*wd as u8);
             }
-
-            /// The code of a data-less request.
-            fn no_data_code(&self) -> Option<u8> {
-                match self {
-                    $(Self::$variant => Some($code),)*
-                    _ => None,
-                }
+        };
+        /// 0x54 make the servo's current position its zero.
+        SetServoCalibration {
+            /// Servo.
+            servo: ServoId,
+        } = cmd::SET_SERVO_CALIBRATION, reply ReplyKind::Ack,
+        data 1 => |f| Self::SetServoCalibration { servo: f.servo()? },
+        emit |w| { w.u8(servo.get()); };
+        /// 0x55 brake one joint.
+        JointBrake {
+            /// Servo.
+            servo: ServoId,
+        } = cmd::JOINT_BRAKE, reply ReplyKind::Ack,
+        data 1 => |f| Self::JointBrake { servo: f.servo()? },
+        emit |w| { w.u8(servo.get()); };
+        /// 0x56 release one servo: LEN 3, or LEN 4 with the undamped flag.
+        ReleaseServo {
+            /// Servo.
+            servo: ServoId,
+            /// Optional undamped flag.
+            undamped: Option<bool>,
+        } = cmd::RELEASE_SERVO, reply ReplyKind::Ack,
+        data 1 | 2 => |f| Self::ReleaseServo {
+            servo: f.servo()?,
+            undamped: f.optional(Fields::flag)?,
+        },
+        emit |w| {
+            w.u8(servo.get());
+            if let Some(u) = undamped {
+                w.u8(u8::from(*u));
             }
-        }
-    };
-}
+        };
+        /// 0x57 focus servo (torque on); wire 0 = all.
+        FocusServo {
+            /// Servo or all.
+            servo: ServoSelect,
+        } = cmd::FOCUS_SERVO, reply ReplyKind::Ack,
+        data 1 => |f| Self::FocusServo { servo: f.servo_or_all(0)? },
+        emit |w| { w.u8(select_byte(*servo, 0)); };
+        /// 0xE1 get servo speeds.
+        GetServoSpeeds = cmd::GET_SERVO_SPEEDS, reply ReplyKind::Int16x6;
+        /// 0xE2 get servo currents.
+        GetServoCurrents = cmd::GET_SERVO_CURRENTS, reply ReplyKind::Int16x6;
+        /// 0xE3 get servo voltages.
+        GetServoVoltages = cmd::GET_SERVO_VOLTAGES, reply ReplyKind::Bytes6;
+        /// 0xE4 get servo status.
+        GetServoStatus = cmd::GET_SERVO_STATUS, reply ReplyKind::Bytes6;
+        /// 0xE5 get servo temperatures.
+        GetServoTemps = cmd::GET_SERVO_TEMPS, reply ReplyKind::Bytes6;
+        /// 0xEA back up servo parameters; wire 254 = all.
+        BackupServoParams {
+            /// Servo or all.
+            servo: ServoSelect,
+        } = cmd::BACKUP_SERVO_PARAMS, reply ReplyKind::Ack,
+        data 1 => |f| Self::BackupServoParams { servo: f.servo_or_all(254)? },
+        emit |w| { w.u8(select_byte(*servo, 254)); };
+        /// 0xEB restore servo parameters; wire 254 = all.
+        RestoreServoParams {
+            /// Servo or all.
+            servo: ServoSelect,
+        } = cmd::RESTORE_SERVO_PARAMS, reply ReplyKind::Ack,
+        data 1 => |f| Self::RestoreServoParams { servo: f.servo_or_all(254)? },
+        emit |w| { w.u8(select_byte(*servo, 254)); };
 
-no_data_commands! {
-    GetModifyVersion = cmd::GET_MODIFY_VERSION,
-    GetSystemVersion = cmd::GET_SYSTEM_VERSION,
-    ClearQueue = cmd::CLEAR_QUEUE,
-    CheckAsyncOrSync = cmd::CHECK_ASYNC_OR_SYNC,
-    GetErrorInfo = cmd::GET_ERROR_INFO,
-    ClearErrorInfo = cmd::CLEAR_ERROR_INFO,
-    PowerOn = cmd::POWER_ON,
-    PowerOff = cmd::POWER_OFF,
-    IsPowerOn = cmd::IS_POWER_ON,
-    IsControllerConnected = cmd::IS_CONTROLLER_CONNECTED,
-    ReadNextError = cmd::READ_NEXT_ERROR,
-    GetFreshMode = cmd::GET_FRESH_MODE,
-    IsFreeMode = cmd::IS_FREE_MODE,
-    GetRebootCount = cmd::GET_REBOOT_COUNT,
-    GetAngles = cmd::GET_ANGLES,
-    GetCoords = cmd::GET_COORDS,
-    Pause = cmd::PAUSE,
-    IsPaused = cmd::IS_PAUSED,
-    Resume = cmd::RESUME,
-    Stop = cmd::STOP,
-    IsMoving = cmd::IS_MOVING,
-    GetAnglesCoords = cmd::GET_ANGLES_COORDS,
-    GetPlannedAngles = cmd::GET_PLANNED_ANGLES,
-    GetPlannedCoords = cmd::GET_PLANNED_COORDS,
-    MoveRound = cmd::MOVE_ROUND,
-    SetFourPiecesZero = cmd::SET_FOUR_PIECES_ZERO,
-    JogStop = cmd::JOG_STOP,
-    GetEncoders = cmd::GET_ENCODERS,
-    GetSpeed = cmd::GET_SPEED,
-    AreAllServosEnabled = cmd::ARE_ALL_SERVOS_ENABLED,
-    GetServoSpeeds = cmd::GET_SERVO_SPEEDS,
-    GetServoCurrents = cmd::GET_SERVO_CURRENTS,
-    GetServoVoltages = cmd::GET_SERVO_VOLTAGES,
-    GetServoStatus = cmd::GET_SERVO_STATUS,
-    GetServoTemps = cmd::GET_SERVO_TEMPS,
-    SetGripperCalibration = cmd::SET_GRIPPER_CALIBRATION,
-    IsGripperMoving = cmd::IS_GRIPPER_MOVING,
-    GetHtsGripperTorque = cmd::GET_HTS_GRIPPER_TORQUE,
-    GetGripperProtectCurrent = cmd::GET_GRIPPER_PROTECT_CURRENT,
-    InitGripper = cmd::INIT_GRIPPER,
-    GetToolReference = cmd::GET_TOOL_REFERENCE,
-    GetWorldReference = cmd::GET_WORLD_REFERENCE,
-    GetReferenceFrame = cmd::GET_REFERENCE_FRAME,
-    GetMovementType = cmd::GET_MOVEMENT_TYPE,
-    GetEndType = cmd::GET_END_TYPE,
-    GetSsidPwd = cmd::GET_SSID_PWD,
-    GetTofDistance = cmd::GET_TOF_DISTANCE,
-    GetBasicVersion = cmd::GET_BASIC_VERSION,
-    GetTransponderMode = cmd::GET_TRANSPONDER_MODE,
-    DragStartRecord = cmd::DRAG_START_RECORD,
-    DragEndRecord = cmd::DRAG_END_RECORD,
-    DragGetRecordData = cmd::DRAG_GET_RECORD_DATA,
-    DragGetRecordLen = cmd::DRAG_GET_RECORD_LEN,
-    DragClearRecordData = cmd::DRAG_CLEAR_RECORD_DATA,
-    GetPid = cmd::GET_PID,
-}
+        // --- Atom IO, LED, gripper ---
 
-/// Reads a frame's fields, turning each raw byte into its validated type.
-struct Fields<'a> {
-    r: Reader<'a>,
-    short: CommandError,
-}
-
-impl Fields<'_> {
-    fn u8(&mut self) -> Result<u8, CommandError> {
-        self.r.u8().ok_or(self.short)
-    }
-
-    fn i16(&mut self) -> Result<i16, CommandError> {
-        self.r.i16().ok_or(self.short)
-    }
-
-    fn flag(&mut self) -> Result<bool, CommandError> {
-        match self.u8()? {
-            0 => Ok(false),
-            1 => Ok(true),
-            v => Err(CommandError::BadFlag(v)),
-        }
-    }
-
-    fn enum_byte<T>(&mut self, from: fn(u8) -> Option<T>) -> Result<T, CommandError> {
-        let v = self.u8()?;
-        from(v).ok_or(CommandError::BadFlag(v))
-    }
-
-    fn joint(&mut self) -> Result<JointId, CommandError> {
-        let v = self.u8()?;
-        JointId::new(v).ok_or(CommandError::BadJoint(v))
-    }
-
-    fn servo(&mut self) -> Result<ServoId, CommandError> {
-        let v = self.u8()?;
-        ServoId::new(v).ok_or(CommandError::BadServo(v))
-    }
-
-    fn servo_or_all(&mut self, all: u8) -> Result<ServoSelect, CommandError> {
-        let v = self.u8()?;
-        if v == all {
-            return Ok(ServoSelect::All);
-        }
-        ServoId::new(v)
-            .map(ServoSelect::One)
-            .ok_or(CommandError::BadServo(v))
-    }
-
-    fn address(&mut self) -> Result<u8, CommandError> {
-        let v = self.u8()?;
-        if v < MIN_SERVO_ADDRESS {
-            return Err(CommandError::BadAddress(v));
-        }
-        Ok(v)
-    }
-
-    fn speed(&mut self) -> Result<SpeedPercent, CommandError> {
-        let v = self.u8()?;
-        SpeedPercent::new(v).ok_or(CommandError::BadSpeed(v))
-    }
-
-    fn gripper_speed(&mut self) -> Result<GripperSpeed, CommandError> {
-        let v = self.u8()?;
-        GripperSpeed::new(v).ok_or(CommandError::BadSpeed(v))
-    }
-
-    fn gripper_type(&mut self) -> Result<GripperType, CommandError> {
-        let v = self.u8()?;
-        GripperType::new(v).ok_or(CommandError::BadGripperValue(v))
-    }
-
-    /// The optional type / torque tail of 0x66/0x67, from the number of bytes left.
-    fn gripper_model(&mut self, tail_len: usize) -> Result<GripperModel, CommandError> {
-        Ok(match tail_len {
-            0 => GripperModel::Default,
-            1 => GripperModel::Typed(self.gripper_type()?),
-            _ => {
-                let kind = self.gripper_type()?;
-                GripperModel::TypedTorque(kind, self.flag()?)
+        /// 0x60 set an Atom pin's mode.
+        SetPinMode {
+            /// Pin.
+            pin: AtomPin,
+            /// Mode (pin 39 is input only).
+            mode: PinMode,
+        } = cmd::SET_PIN_MODE, reply ReplyKind::Ack,
+        data 2 => |f| {
+            let pin = f.atom_pin()?;
+            let mode = f.enum_byte(PinMode::from_u8)?;
+            if mode == PinMode::Output && !pin.can_output() {
+                return Err(CommandError::BadPin(pin.gpio()));
             }
-        })
-    }
+            Self::SetPinMode { pin, mode }
+        },
+        emit |w| { w.u8(pin.gpio()).u8(*mode as u8); };
+        /// 0x61 set an Atom digital output.
+        SetDigitalOutput {
+            /// Pin (never 39).
+            pin: AtomPin,
+            /// High.
+            high: bool,
+        } = cmd::SET_DIGITAL_OUTPUT, reply ReplyKind::Ack,
+        data 2 => |f| Self::SetDigitalOutput { pin: f.atom_output_pin()?, high: f.flag()? },
+        emit |w| { w.u8(pin.gpio()).u8(u8::from(*high)); };
+        /// 0x62 get an Atom digital input.
+        GetDigitalInput {
+            /// Pin.
+            pin: AtomPin,
+        } = cmd::GET_DIGITAL_INPUT, reply ReplyKind::PinLevel,
+        data 1 => |f| Self::GetDigitalInput { pin: f.atom_pin()? },
+        emit |w| { w.u8(pin.gpio()); };
+        /// 0x64 set an Atom PWM output.
+        SetPwmOutput {
+            /// Pin (never 39).
+            pin: AtomPin,
+            /// Frequency, hertz.
+            frequency_hz: u16,
+            /// Duty, 0..=255 of full scale.
+            duty: u8,
+        } = cmd::SET_PWM_OUTPUT, reply ReplyKind::Ack,
+        data 4 => |f| Self::SetPwmOutput {
+            pin: f.atom_output_pin()?,
+            frequency_hz: f.i16()? as u16,
+            duty: f.u8()?,
+        },
+        emit |w| { w.u8(pin.gpio()).bytes(&frequency_hz.to_be_bytes()).u8(*duty); };
+        /// 0x65 get gripper value: LEN 2, or LEN 3 with a gripper type.
+        GetGripperValue {
+            /// Gripper type, if given.
+            gripper: Option<GripperType>,
+        } = cmd::GET_GRIPPER_VALUE, reply ReplyKind::Byte,
+        data 0 | 1 => |f| Self::GetGripperValue { gripper: f.optional(Fields::gripper_type)? },
+        emit |w| {
+            if let Some(g) = gripper {
+                w.u8(g.get());
+            }
+        };
+        /// 0x66 (LEN 3, seed manual) set gripper state with no speed.
+        SetGripperStateNoSpeed {
+            /// State.
+            state: GripperState,
+        } = cmd::SET_GRIPPER_STATE, reply ReplyKind::Ack,
+        data 1 => |f| Self::SetGripperStateNoSpeed { state: f.gripper_state()? },
+        emit |w| { w.u8(*state as u8); };
+        /// 0x66 set gripper state: LEN 4, 5 (type) or 6 (type, torque).
+        SetGripperState {
+            /// State.
+            state: GripperState,
+            /// Speed.
+            speed: GripperSpeed,
+            /// Optional type / torque tail.
+            model: GripperModel,
+        } = cmd::SET_GRIPPER_STATE, reply ReplyKind::Ack,
+        data 2..=4 => |f| Self::SetGripperState {
+            state: f.gripper_state()?,
+            speed: f.gripper_speed()?,
+            model: f.gripper_model()?,
+        },
+        emit |w| {
+            w.u8(*state as u8).u8(speed.get());
+            gripper_model(w, *model);
+        };
+        /// 0x67 set gripper opening: LEN 4, 5 (type) or 6 (type, torque).
+        SetGripperValue {
+            /// Opening.
+            value: GripperValue,
+            /// Speed.
+            speed: GripperSpeed,
+            /// Optional type / torque tail.
+            model: GripperModel,
+        } = cmd::SET_GRIPPER_VALUE, reply ReplyKind::Ack,
+        data 2..=4 => |f| Self::SetGripperValue {
+            value: f.gripper_value()?,
+            speed: f.gripper_speed()?,
+            model: f.gripper_model()?,
+        },
+        emit |w| {
+            w.u8(value.get()).u8(speed.get());
+            gripper_model(w, *model);
+        };
+        /// 0x68 calibrate the gripper.
+        SetGripperCalibration = cmd::SET_GRIPPER_CALIBRATION, reply ReplyKind::Ack;
+        /// 0x69 is gripper moving.
+        IsGripperMoving = cmd::IS_GRIPPER_MOVING, reply ReplyKind::Byte;
+        /// 0x6A set the Atom LED colour.
+        SetColor {
+            /// Colour.
+            rgb: Rgb,
+        } = cmd::SET_COLOR, reply ReplyKind::Ack,
+        data 3 => |f| Self::SetColor { rgb: Rgb { r: f.u8()?, g: f.u8()?, b: f.u8()? } },
+        emit |w| { w.u8(rgb.r).u8(rgb.g).u8(rgb.b); };
+        /// 0x35 set HTS gripper torque, 150..=980.
+        SetHtsGripperTorque {
+            /// Torque.
+            torque: i16,
+        } = cmd::SET_HTS_GRIPPER_TORQUE, reply ReplyKind::Ack,
+        data 2 => |f| Self::SetHtsGripperTorque { torque: f.limited_i16(HTS_TORQUE_RANGE)? },
+        emit |w| { w.i16(*torque); };
+        /// 0x36 get HTS gripper torque.
+        GetHtsGripperTorque = cmd::GET_HTS_GRIPPER_TORQUE, reply ReplyKind::Int16;
+        /// 0x37 get gripper protect current.
+        GetGripperProtectCurrent = cmd::GET_GRIPPER_PROTECT_CURRENT, reply ReplyKind::Int16;
+        /// 0x38 init gripper.
+        InitGripper = cmd::INIT_GRIPPER, reply ReplyKind::Byte;
+        /// 0x39 set gripper protect current, 1..=500.
+        SetGripperProtectCurrent {
+            /// Current.
+            current: i16,
+        } = cmd::SET_GRIPPER_PROTECT_CURRENT, reply ReplyKind::Ack,
+        data 2 => |f| Self::SetGripperProtectCurrent {
+            current: f.limited_i16(PROTECT_CURRENT_RANGE)?,
+        },
+        emit |w| { w.i16(*current); };
 
-    fn direction(&mut self) -> Result<Direction, CommandError> {
-        let v = self.u8()?;
-        Direction::from_u8(v).ok_or(CommandError::BadDirection(v))
-    }
+        // --- coordinate frames ---
 
-    fn axis(&mut self) -> Result<Axis, CommandError> {
-        let v = self.u8()?;
-        Axis::from_u8(v).ok_or(CommandError::BadAxis(v))
-    }
+        /// 0x81 set tool reference.
+        SetToolReference {
+            /// Tool pose in the flange frame.
+            pose: Pose,
+        } = cmd::SET_TOOL_REFERENCE, reply ReplyKind::Ack,
+        data 12 => |f| Self::SetToolReference { pose: f.pose()? },
+        emit |w| { w.pose(pose); };
+        /// 0x82 get tool reference.
+        GetToolReference = cmd::GET_TOOL_REFERENCE, reply ReplyKind::Coords;
+        /// 0x83 set world reference.
+        SetWorldReference {
+            /// Base pose in the world frame.
+            pose: Pose,
+        } = cmd::SET_WORLD_REFERENCE, reply ReplyKind::Ack,
+        data 12 => |f| Self::SetWorldReference { pose: f.pose()? },
+        emit |w| { w.pose(pose); };
+        /// 0x84 get world reference.
+        GetWorldReference = cmd::GET_WORLD_REFERENCE, reply ReplyKind::Coords;
+        /// 0x85 set reference frame.
+        SetReferenceFrame {
+            /// Frame.
+            frame: ReferenceFrame,
+        } = cmd::SET_REFERENCE_FRAME, reply ReplyKind::Ack,
+        data 1 => |f| Self::SetReferenceFrame { frame: f.enum_byte(ReferenceFrame::from_u8)? },
+        emit |w| { w.u8(*frame as u8); };
+        /// 0x86 get reference frame.
+        GetReferenceFrame = cmd::GET_REFERENCE_FRAME, reply ReplyKind::Byte;
+        /// 0x87 set movement type.
+        SetMovementType {
+            /// Type.
+            mode: MoveMode,
+        } = cmd::SET_MOVEMENT_TYPE, reply ReplyKind::Ack,
+        data 1 => |f| Self::SetMovementType { mode: f.enum_byte(MoveMode::from_u8)? },
+        emit |w| { w.u8(*mode as u8); };
+        /// 0x88 get movement type.
+        GetMovementType = cmd::GET_MOVEMENT_TYPE, reply ReplyKind::Byte;
+        /// 0x89 set end type.
+        SetEndType {
+            /// End.
+            end: EndType,
+        } = cmd::SET_END_TYPE, reply ReplyKind::Ack,
+        data 1 => |f| Self::SetEndType { end: f.enum_byte(EndType::from_u8)? },
+        emit |w| { w.u8(*end as u8); };
+        /// 0x8A get end type.
+        GetEndType = cmd::GET_END_TYPE, reply ReplyKind::Byte;
 
-    fn axis_value(&mut self) -> Result<AxisValue, CommandError> {
-        let axis = self.axis()?;
-        Ok(AxisValue::new(axis, self.i16()?))
-    }
+        // --- answered by the Basic ---
 
-    fn encoder(&mut self) -> Result<Steps, CommandError> {
-        let v = self.i16()?;
-        if !(0..=MAX_ENCODER).contains(&v) {
-            return Err(CommandError::BadEncoder(v));
-        }
-        Ok(Steps(v))
-    }
+        /// 0xA0 set a Basic output.
+        SetBasicOutput {
+            /// Pin.
+            pin: BasicOutputPin,
+            /// High.
+            high: bool,
+        } = cmd::SET_BASIC_OUTPUT, reply ReplyKind::Ack,
+        data 2 => |f| Self::SetBasicOutput { pin: f.basic_output_pin()?, high: f.flag()? },
+        emit |w| { w.u8(pin.gpio()).u8(u8::from(*high)); };
+        /// 0xA1 get a Basic input.
+        GetBasicInput {
+            /// Pin.
+            pin: BasicInputPin,
+        } = cmd::GET_BASIC_INPUT, reply ReplyKind::PinLevel,
+        data 1 => |f| Self::GetBasicInput { pin: f.basic_input_pin()? },
+        emit |w| { w.u8(pin.gpio()); };
+        /// 0xB0 set Wi-Fi SSID and password. pymycobot sends it empty (an announcing frame) and
+        /// the credentials 20 ms later as bare text `'ssid'(password)`, outside any frame; a
+        /// client may also frame that text here (`firmware_basic::wifi::config`).
+        SetSsidPwd {
+            /// Payload.
+            payload: Vec<u8, MAX_DATA>,
+        } = cmd::SET_SSID_PWD, reply ReplyKind::Ack,
+        data _ => |f| Self::SetSsidPwd { payload: f.payload()? },
+        emit |w| { w.bytes(payload); };
+        /// 0xB1 get Wi-Fi SSID and password.
+        GetSsidPwd = cmd::GET_SSID_PWD, reply ReplyKind::Raw;
+        /// 0xB2 set server port.
+        SetServerPort {
+            /// TCP port.
+            port: u16,
+        } = cmd::SET_SERVER_PORT, reply ReplyKind::Ack,
+        data 2 => |f| Self::SetServerPort { port: f.i16()? as u16 },
+        emit |w| { w.bytes(&port.to_be_bytes()); };
+        /// 0xC0 get ToF distance.
+        GetTofDistance = cmd::GET_TOF_DISTANCE, reply ReplyKind::Int16;
+        /// 0xC1 get Basic version.
+        GetBasicVersion = cmd::GET_BASIC_VERSION, reply ReplyKind::Byte;
+        /// 0xC2 set transponder mode.
+        SetTransponderMode {
+            /// Mode.
+            mode: TransponderMode,
+        } = cmd::SET_TRANSPONDER_MODE, reply ReplyKind::Ack,
+        data 1 => |f| Self::SetTransponderMode { mode: f.enum_byte(TransponderMode::from_u8)? },
+        emit |w| { w.u8(*mode as u8); };
+        /// 0xC3 get transponder mode.
+        GetTransponderMode = cmd::GET_TRANSPONDER_MODE, reply ReplyKind::Byte;
 
-    fn encoders(&mut self) -> Result<[Steps; 6], CommandError> {
-        let mut out = [Steps(0); 6];
-        for e in &mut out {
-            *e = self.encoder()?;
-        }
-        Ok(out)
-    }
+        // --- drag teaching ---
 
-    fn centideg6(&mut self) -> Result<[Centideg; 6], CommandError> {
-        self.r.centideg6().ok_or(self.short)
-    }
-
-    fn pose(&mut self) -> Result<Pose, CommandError> {
-        self.r.pose().ok_or(self.short)
-    }
-
-    fn atom_pin(&mut self) -> Result<AtomPin, CommandError> {
-        let v = self.u8()?;
-        AtomPin::new(v).ok_or(CommandError::BadPin(v))
-    }
-
-    fn atom_output_pin(&mut self) -> Result<AtomPin, CommandError> {
-        let v = self.u8()?;
-        AtomPin::output(v).ok_or(CommandError::BadPin(v))
-    }
-
-    fn limited_i16(&mut self, range: core::ops::RangeInclusive<i16>) -> Result<i16, CommandError> {
-        let v = self.i16()?;
-        if !range.contains(&v) {
-            return Err(CommandError::BadGripperSetting(v));
-        }
-        Ok(v)
+        /// 0xF1 start recording.
+        DragStartRecord = cmd::DRAG_START_RECORD, reply ReplyKind::Int16;
+        /// 0xF2 end recording.
+        DragEndRecord = cmd::DRAG_END_RECORD, reply ReplyKind::Int16;
+        /// 0xF3 get recorded data.
+        DragGetRecordData = cmd::DRAG_GET_RECORD_DATA, reply ReplyKind::DragPoint;
+        /// 0xF4 get record length.
+        DragGetRecordLen = cmd::DRAG_GET_RECORD_LEN, reply ReplyKind::Int16;
+        /// 0xF5 clear recorded data.
+        DragClearRecordData = cmd::DRAG_CLEAR_RECORD_DATA, reply ReplyKind::Int16;
     }
 }
 
@@ -772,696 +822,29 @@ impl Request {
     pub fn parse(frame: &Frame) -> Result<Self, CommandError> {
         let code = frame.cmd();
         let data = frame.data();
-        let n = data.len();
-        // n <= MAX_DATA = 62, so the cast is exact.
         let bad_len = if cmd::is_known(code) {
             CommandError::BadLength {
                 cmd: code,
-                data_len: n as u8,
+                // data.len() <= MAX_DATA = 62, so the cast is exact.
+                data_len: data.len() as u8,
             }
         } else {
             CommandError::UnknownCommand { cmd: code }
         };
-        if n == 0
-            && let Some(req) = Self::from_no_data(code)
-        {
-            return Ok(req);
-        }
-        let mut f = Fields {
-            r: Reader::new(data),
-            short: bad_len,
-        };
-        let req = match (code, n) {
-            (cmd::RELEASE_ALL_SERVOS, 0) => Self::ReleaseAllServos { undamped: None },
-            (cmd::RELEASE_ALL_SERVOS, 1) => Self::ReleaseAllServos {
-                undamped: Some(f.flag()?),
-            },
-            (cmd::SET_FRESH_MODE, 1) => Self::SetFreshMode { fresh: f.flag()? },
-            (cmd::SET_FREE_MODE, 1) => Self::SetFreeMode { on: f.flag()? },
-            (cmd::SET_VISION_MODE, 1) => Self::SetVisionMode { on: f.flag()? },
-
-            (cmd::SEND_ANGLE, 4) => Self::SendAngle {
-                joint: f.joint()?,
-                angle: Centideg(f.i16()?),
-                speed: f.speed()?,
-            },
-            (cmd::SEND_ANGLES, 13) => Self::SendAngles {
-                angles: f.centideg6()?,
-                speed: f.speed()?,
-            },
-            (cmd::GET_COORDS, 12) => Self::AnglesToCoords {
-                angles: f.centideg6()?,
-            },
-            (cmd::SEND_COORD, 4) => Self::SendCoord {
-                target: {
-                    let v = f.u8()?;
-                    let axis = Axis::from_send_coord_byte(v).ok_or(CommandError::BadAxis(v))?;
-                    AxisValue::new(axis, f.i16()?)
-                },
-                speed: f.speed()?,
-            },
-            (cmd::SEND_COORDS, 13 | 14) => Self::SendCoords {
-                pose: f.pose()?,
-                speed: f.speed()?,
-                mode: if n == 14 {
-                    Some(f.enum_byte(MoveMode::from_u8)?)
-                } else {
-                    None
-                },
-            },
-            (cmd::IS_IN_POSITION, 13) => {
-                let values = f.r.i16x6().ok_or(bad_len)?;
-                Self::IsInPosition {
-                    target: match f.flag()? {
-                        false => PositionTarget::Angles(values.map(Centideg)),
-                        true => PositionTarget::Coords(Pose::from_array(values)),
-                    },
-                }
-            }
-            (cmd::SET_PID, 6) => Self::SetPid {
-                gains: [f.u8()?, f.u8()?, f.u8()?, f.u8()?, f.u8()?, f.u8()?],
-            },
-            (cmd::MOVE_C_COORDS, 36) => Self::MoveCCoords {
-                begin: f.pose()?,
-                middle: f.pose()?,
-                end: f.pose()?,
-            },
-            (cmd::MOVE_C_COORDS_FROM_HERE, 24) => Self::MoveCCoordsFromHere {
-                middle: f.pose()?,
-                end: f.pose()?,
-            },
-            (cmd::SOLVE_INV_KINEMATICS, 24) => Self::SolveIk {
-                target: f.pose()?,
-                current: f.centideg6()?,
-            },
-
-            (cmd::JOG_ANGLE, 3) => Self::JogAngle {
-                joint: f.joint()?,
-                direction: f.direction()?,
-                speed: f.speed()?,
-            },
-            (cmd::JOG_RPY, 3) => Self::JogRpy {
-                axis: {
-                    let v = f.u8()?;
-                    RpyAxis::from_u8(v).ok_or(CommandError::BadAxis(v))?
-                },
-                direction: f.direction()?,
-                speed: f.speed()?,
-            },
-            (cmd::JOG_COORD, 3) => Self::JogCoord {
-                axis: f.axis()?,
-                direction: f.direction()?,
-                speed: f.speed()?,
-            },
-            (cmd::JOG_INCREMENT_ANGLE, 4) => Self::JogIncrementAngle {
-                joint: f.joint()?,
-                increment: Centideg(f.i16()?),
-                speed: f.speed()?,
-            },
-            (cmd::JOG_INCREMENT_COORD, 4) => Self::JogIncrementCoord {
-                increment: f.axis_value()?,
-                speed: f.speed()?,
-            },
-
-            (cmd::SET_ENCODER, 3 | 4) => Self::SetEncoder {
-                servo: f.servo()?,
-                encoder: f.encoder()?,
-                speed: if n == 4 { Some(f.speed()?) } else { None },
-            },
-            (cmd::GET_ENCODER, 1) => Self::GetEncoder { servo: f.servo()? },
-            (cmd::SET_ENCODERS, 13) => Self::SetEncoders {
-                encoders: f.encoders()?,
-                speed: f.speed()?,
-            },
-            (cmd::SET_ENCODERS_DRAG, 24) => {
-                let encoders = f.encoders()?;
-                let speeds = f.r.i16x6().ok_or(bad_len)?;
-                if let Some(&bad) = speeds.iter().find(|s| !(0..=MAX_DRAG_SPEED).contains(*s)) {
-                    return Err(CommandError::BadDragSpeed(bad));
-                }
-                Self::SetEncodersDrag {
-                    encoders,
-                    speeds_steps_per_s: speeds,
-                }
-            }
-            (cmd::SET_SPEED, 1) => Self::SetSpeed { speed: f.speed()? },
-            (cmd::GET_JOINT_MIN, 1) => Self::GetJointMin { joint: f.joint()? },
-            (cmd::GET_JOINT_MAX, 1) => Self::GetJointMax { joint: f.joint()? },
-            (cmd::SET_JOINT_MIN, 3) => Self::SetJointMin {
-                joint: f.joint()?,
-                limit: Decideg(f.i16()?),
-            },
-            (cmd::SET_JOINT_MAX, 3) => Self::SetJointMax {
-                joint: f.joint()?,
-                limit: Decideg(f.i16()?),
-            },
-
-            (cmd::IS_SERVO_ENABLED, 1) => Self::IsServoEnabled { servo: f.servo()? },
-            (cmd::SET_SERVO_DATA, 3) => Self::SetServoData {
-                servo: f.servo()?,
-                address: f.address()?,
-                value: ServoValue::Byte(f.u8()?),
-            },
-            (cmd::SET_SERVO_DATA, 5) => {
-                let servo = f.servo()?;
-                let address = f.address()?;
-                let word = f.i16()? as u16;
-                // pymycobot's `set_servo_data(.., mode)` always sends the value in two bytes
-                // and the flag says the register's width: 1 a word, 0 one byte (the low one).
-                match (f.u8()?, u8::try_from(word)) {
-                    (1, _) => Self::SetServoData {
-                        servo,
-                        address,
-                        value: ServoValue::Word(word),
-                    },
-                    (0, Ok(byte)) => Self::SetServoData {
-                        servo,
-                        address,
-                        value: ServoValue::Byte(byte),
-                    },
-                    (v, _) => return Err(CommandError::BadFlag(v)),
-                }
-            }
-            (cmd::GET_SERVO_DATA, 2 | 3) => Self::GetServoData {
-                servo: f.servo()?,
-                address: f.u8()?,
-                width: if n == 3 {
-                    Some(f.enum_byte(DataWidth::from_u8)?)
-                } else {
-                    None
-                },
-            },
-            (cmd::SET_SERVO_CALIBRATION, 1) => Self::SetServoCalibration { servo: f.servo()? },
-            (cmd::JOINT_BRAKE, 1) => Self::JointBrake { servo: f.servo()? },
-            (cmd::RELEASE_SERVO, 1 | 2) => Self::ReleaseServo {
-                servo: f.servo()?,
-                undamped: if n == 2 { Some(f.flag()?) } else { None },
-            },
-            (cmd::FOCUS_SERVO, 1) => Self::FocusServo {
-                servo: f.servo_or_all(0)?,
-            },
-            (cmd::BACKUP_SERVO_PARAMS, 1) => Self::BackupServoParams {
-                servo: f.servo_or_all(254)?,
-            },
-            (cmd::RESTORE_SERVO_PARAMS, 1) => Self::RestoreServoParams {
-                servo: f.servo_or_all(254)?,
-            },
-
-            (cmd::SET_PIN_MODE, 2) => {
-                let pin = f.atom_pin()?;
-                let mode = f.enum_byte(PinMode::from_u8)?;
-                if mode == PinMode::Output && !pin.can_output() {
-                    return Err(CommandError::BadPin(pin.gpio()));
-                }
-                Self::SetPinMode { pin, mode }
-            }
-            (cmd::SET_DIGITAL_OUTPUT, 2) => Self::SetDigitalOutput {
-                pin: f.atom_output_pin()?,
-                high: f.flag()?,
-            },
-            (cmd::GET_DIGITAL_INPUT, 1) => Self::GetDigitalInput { pin: f.atom_pin()? },
-            (cmd::SET_PWM_OUTPUT, 4) => Self::SetPwmOutput {
-                pin: f.atom_output_pin()?,
-                frequency_hz: f.i16()? as u16,
-                duty: f.u8()?,
-            },
-            (cmd::GET_GRIPPER_VALUE, 0 | 1) => Self::GetGripperValue {
-                gripper: if n == 1 {
-                    Some(f.gripper_type()?)
-                } else {
-                    None
-                },
-            },
-            (cmd::SET_GRIPPER_STATE, 1) => Self::SetGripperStateNoSpeed {
-                state: {
-                    let v = f.u8()?;
-                    GripperState::from_u8(v).ok_or(CommandError::BadGripperValue(v))?
-                },
-            },
-            (cmd::SET_GRIPPER_STATE, 2..=4) => Self::SetGripperState {
-                state: {
-                    let v = f.u8()?;
-                    GripperState::from_u8(v).ok_or(CommandError::BadGripperValue(v))?
-                },
-                speed: f.gripper_speed()?,
-                model: f.gripper_model(n - 2)?,
-            },
-            (cmd::SET_GRIPPER_VALUE, 2..=4) => Self::SetGripperValue {
-                value: {
-                    let v = f.u8()?;
-                    GripperValue::new(v).ok_or(CommandError::BadGripperValue(v))?
-                },
-                speed: f.gripper_speed()?,
-                model: f.gripper_model(n - 2)?,
-            },
-            (cmd::SET_COLOR, 3) => Self::SetColor {
-                rgb: Rgb {
-                    r: f.u8()?,
-                    g: f.u8()?,
-                    b: f.u8()?,
-                },
-            },
-            (cmd::SET_HTS_GRIPPER_TORQUE, 2) => Self::SetHtsGripperTorque {
-                torque: f.limited_i16(HTS_TORQUE_RANGE)?,
-            },
-            (cmd::SET_GRIPPER_PROTECT_CURRENT, 2) => Self::SetGripperProtectCurrent {
-                current: f.limited_i16(PROTECT_CURRENT_RANGE)?,
-            },
-
-            (cmd::SET_TOOL_REFERENCE, 12) => Self::SetToolReference { pose: f.pose()? },
-            (cmd::SET_WORLD_REFERENCE, 12) => Self::SetWorldReference { pose: f.pose()? },
-            (cmd::SET_REFERENCE_FRAME, 1) => Self::SetReferenceFrame {
-                frame: f.enum_byte(ReferenceFrame::from_u8)?,
-            },
-            (cmd::SET_MOVEMENT_TYPE, 1) => Self::SetMovementType {
-                mode: f.enum_byte(MoveMode::from_u8)?,
-            },
-            (cmd::SET_END_TYPE, 1) => Self::SetEndType {
-                end: f.enum_byte(EndType::from_u8)?,
-            },
-
-            (cmd::SET_BASIC_OUTPUT, 2) => Self::SetBasicOutput {
-                pin: {
-                    let v = f.u8()?;
-                    BasicOutputPin::new(v).ok_or(CommandError::BadPin(v))?
-                },
-                high: f.flag()?,
-            },
-            (cmd::GET_BASIC_INPUT, 1) => Self::GetBasicInput {
-                pin: {
-                    let v = f.u8()?;
-                    BasicInputPin::new(v).ok_or(CommandError::BadPin(v))?
-                },
-            },
-            (cmd::SET_SSID_PWD, _) => Self::SetSsidPwd {
-                // data.len() <= MAX_DATA, the capacity.
-                payload: Vec::from_slice(data).map_err(|_| bad_len)?,
-            },
-            (cmd::SET_SERVER_PORT, 2) => Self::SetServerPort {
-                port: f.i16()? as u16,
-            },
-            (cmd::SET_TRANSPONDER_MODE, 1) => Self::SetTransponderMode {
-                mode: f.enum_byte(TransponderMode::from_u8)?,
-            },
-            _ => return Err(bad_len),
-        };
-        Ok(req)
+        Self::parse_data(code, &mut Fields::new(data, bad_len))
     }
 
     /// The command code (CMD byte) of this request.
     pub fn cmd(&self) -> u8 {
-        self.encode().0
+        self.kind().cmd()
     }
 
     /// The frame a client sends for this request. `Request::parse(&r.to_frame()) == Ok(r)`
     /// for every valid request.
     pub fn to_frame(&self) -> Frame {
-        let (code, w) = self.encode();
-        w.frame(code)
-    }
-
-    /// Shape of the reply this request expects (`protocol.md` section 5), for
-    /// [`Reply::parse`](super::Reply::parse).
-    pub fn reply_kind(&self) -> ReplyKind {
-        use ReplyKind as K;
-        match self {
-            Self::GetModifyVersion
-            | Self::GetSystemVersion
-            | Self::CheckAsyncOrSync
-            | Self::GetErrorInfo
-            | Self::IsPowerOn
-            | Self::IsControllerConnected
-            | Self::GetFreshMode
-            | Self::IsFreeMode
-            | Self::IsPaused
-            | Self::IsInPosition { .. }
-            | Self::IsMoving
-            | Self::GetSpeed
-            | Self::AreAllServosEnabled
-            | Self::GetGripperValue { .. }
-            | Self::IsGripperMoving
-            | Self::GetReferenceFrame
-            | Self::GetMovementType
-            | Self::GetEndType
-            | Self::GetBasicVersion
-            | Self::GetTransponderMode
-            | Self::SetFourPiecesZero
-            | Self::InitGripper => K::Byte,
-            Self::GetServoData {
-                width: Some(DataWidth::Word),
-                ..
-            } => K::Int16,
-            Self::GetServoData { .. } => K::Byte,
-            Self::GetRebootCount
-            | Self::GetEncoder { .. }
-            | Self::GetTofDistance
-            | Self::GetHtsGripperTorque
-            | Self::GetGripperProtectCurrent
-            | Self::DragStartRecord
-            | Self::DragEndRecord
-            | Self::DragGetRecordLen
-            | Self::DragClearRecordData => K::Int16,
-            Self::DragGetRecordData => K::DragPoint,
-            Self::GetAngles | Self::GetPlannedAngles | Self::SolveIk { .. } => K::Angles,
-            Self::GetCoords
-            | Self::AnglesToCoords { .. }
-            | Self::GetPlannedCoords
-            | Self::GetToolReference
-            | Self::GetWorldReference => K::Coords,
-            Self::GetEncoders => K::Encoders,
-            Self::GetServoSpeeds | Self::GetServoCurrents => K::Int16x6,
-            Self::GetServoVoltages | Self::GetServoStatus | Self::GetServoTemps | Self::GetPid => {
-                K::Bytes6
-            }
-            Self::ReadNextError => K::ServoErrors,
-            Self::GetAnglesCoords => K::AnglesAndCoords,
-            Self::GetDigitalInput { .. } | Self::GetBasicInput { .. } => K::PinLevel,
-            Self::GetJointMin { .. } | Self::GetJointMax { .. } => K::JointLimit,
-            Self::IsServoEnabled { .. } => K::ServoEnabled,
-            Self::GetSsidPwd => K::Raw,
-            _ => K::Ack,
-        }
-    }
-
-    /// The command code and data bytes of this request.
-    fn encode(&self) -> (u8, Writer) {
         let mut w = Writer::default();
-        if let Some(code) = self.no_data_code() {
-            return (code, w);
-        }
-        let code = match self {
-            Self::ReleaseAllServos { undamped } => {
-                if let Some(u) = undamped {
-                    w.u8(u8::from(*u));
-                }
-                cmd::RELEASE_ALL_SERVOS
-            }
-            Self::SetFreshMode { fresh } => {
-                w.u8(u8::from(*fresh));
-                cmd::SET_FRESH_MODE
-            }
-            Self::SetFreeMode { on } => {
-                w.u8(u8::from(*on));
-                cmd::SET_FREE_MODE
-            }
-            Self::SetVisionMode { on } => {
-                w.u8(u8::from(*on));
-                cmd::SET_VISION_MODE
-            }
-            Self::SendAngle {
-                joint,
-                angle,
-                speed,
-            } => {
-                w.u8(joint.get()).i16(angle.0).u8(speed.get());
-                cmd::SEND_ANGLE
-            }
-            Self::SendAngles { angles, speed } => {
-                w.centideg6(angles).u8(speed.get());
-                cmd::SEND_ANGLES
-            }
-            Self::AnglesToCoords { angles } => {
-                w.centideg6(angles);
-                cmd::GET_COORDS
-            }
-            Self::SendCoord { target, speed } => {
-                w.u8(target.axis() as u8).i16(target.raw()).u8(speed.get());
-                cmd::SEND_COORD
-            }
-            Self::SendCoords { pose, speed, mode } => {
-                w.pose(pose).u8(speed.get());
-                if let Some(m) = mode {
-                    w.u8(*m as u8);
-                }
-                cmd::SEND_COORDS
-            }
-            Self::IsInPosition { target } => {
-                match target {
-                    PositionTarget::Angles(a) => w.centideg6(a).u8(0),
-                    PositionTarget::Coords(p) => w.pose(p).u8(1),
-                };
-                cmd::IS_IN_POSITION
-            }
-            Self::SolveIk { target, current } => {
-                w.pose(target).centideg6(current);
-                cmd::SOLVE_INV_KINEMATICS
-            }
-            Self::SetPid { gains } => {
-                w.bytes(gains);
-                cmd::SET_PID
-            }
-            Self::MoveCCoords { begin, middle, end } => {
-                w.pose(begin).pose(middle).pose(end);
-                cmd::MOVE_C_COORDS
-            }
-            Self::MoveCCoordsFromHere { middle, end } => {
-                w.pose(middle).pose(end);
-                cmd::MOVE_C_COORDS_FROM_HERE
-            }
-            Self::JogAngle {
-                joint,
-                direction,
-                speed,
-            } => {
-                w.u8(joint.get()).u8(*direction as u8).u8(speed.get());
-                cmd::JOG_ANGLE
-            }
-            Self::JogRpy {
-                axis,
-                direction,
-                speed,
-            } => {
-                w.u8(*axis as u8).u8(*direction as u8).u8(speed.get());
-                cmd::JOG_RPY
-            }
-            Self::JogCoord {
-                axis,
-                direction,
-                speed,
-            } => {
-                w.u8(*axis as u8).u8(*direction as u8).u8(speed.get());
-                cmd::JOG_COORD
-            }
-            Self::JogIncrementAngle {
-                joint,
-                increment,
-                speed,
-            } => {
-                w.u8(joint.get()).i16(increment.0).u8(speed.get());
-                cmd::JOG_INCREMENT_ANGLE
-            }
-            Self::JogIncrementCoord { increment, speed } => {
-                w.u8(increment.axis() as u8)
-                    .i16(increment.raw())
-                    .u8(speed.get());
-                cmd::JOG_INCREMENT_COORD
-            }
-            Self::SetEncoder {
-                servo,
-                encoder,
-                speed,
-            } => {
-                w.u8(servo.get()).i16(encoder.0);
-                if let Some(s) = speed {
-                    w.u8(s.get());
-                }
-                cmd::SET_ENCODER
-            }
-            Self::GetEncoder { servo } => {
-                w.u8(servo.get());
-                cmd::GET_ENCODER
-            }
-            Self::SetEncoders { encoders, speed } => {
-                w.steps6(encoders).u8(speed.get());
-                cmd::SET_ENCODERS
-            }
-            Self::SetEncodersDrag {
-                encoders,
-                speeds_steps_per_s,
-            } => {
-                w.steps6(encoders).i16s(speeds_steps_per_s);
-                cmd::SET_ENCODERS_DRAG
-            }
-            Self::SetSpeed { speed } => {
-                w.u8(speed.get());
-                cmd::SET_SPEED
-            }
-            Self::GetJointMin { joint } => {
-                w.u8(joint.get());
-                cmd::GET_JOINT_MIN
-            }
-            Self::GetJointMax { joint } => {
-                w.u8(joint.get());
-                cmd::GET_JOINT_MAX
-            }
-            Self::SetJointMin { joint, limit } => {
-                w.u8(joint.get()).i16(limit.0);
-                cmd::SET_JOINT_MIN
-            }
-            Self::SetJointMax { joint, limit } => {
-                w.u8(joint.get()).i16(limit.0);
-                cmd::SET_JOINT_MAX
-            }
-            Self::IsServoEnabled { servo } => {
-                w.u8(servo.get());
-                cmd::IS_SERVO_ENABLED
-            }
-            Self::SetServoData {
-                servo,
-                address,
-                value,
-            } => {
-                w.u8(servo.get()).u8(*address);
-                match value {
-                    ServoValue::Byte(b) => w.u8(*b),
-                    ServoValue::Word(v) => w.bytes(&v.to_be_bytes()).u8(1),
-                };
-                cmd::SET_SERVO_DATA
-            }
-            Self::GetServoData {
-                servo,
-                address,
-                width,
-            } => {
-                w.u8(servo.get()).u8(*address);
-                if let Some(wd) = width {
-                    w.u8(*wd as u8);
-                }
-                cmd::GET_SERVO_DATA
-            }
-            Self::SetServoCalibration { servo } => {
-                w.u8(servo.get());
-                cmd::SET_SERVO_CALIBRATION
-            }
-            Self::JointBrake { servo } => {
-                w.u8(servo.get());
-                cmd::JOINT_BRAKE
-            }
-            Self::ReleaseServo { servo, undamped } => {
-                w.u8(servo.get());
-                if let Some(u) = undamped {
-                    w.u8(u8::from(*u));
-                }
-                cmd::RELEASE_SERVO
-            }
-            Self::FocusServo { servo } => {
-                w.u8(select_byte(*servo, 0));
-                cmd::FOCUS_SERVO
-            }
-            Self::BackupServoParams { servo } => {
-                w.u8(select_byte(*servo, 254));
-                cmd::BACKUP_SERVO_PARAMS
-            }
-            Self::RestoreServoParams { servo } => {
-                w.u8(select_byte(*servo, 254));
-                cmd::RESTORE_SERVO_PARAMS
-            }
-            Self::SetPinMode { pin, mode } => {
-                w.u8(pin.gpio()).u8(*mode as u8);
-                cmd::SET_PIN_MODE
-            }
-            Self::SetDigitalOutput { pin, high } => {
-                w.u8(pin.gpio()).u8(u8::from(*high));
-                cmd::SET_DIGITAL_OUTPUT
-            }
-            Self::GetDigitalInput { pin } => {
-                w.u8(pin.gpio());
-                cmd::GET_DIGITAL_INPUT
-            }
-            Self::SetPwmOutput {
-                pin,
-                frequency_hz,
-                duty,
-            } => {
-                w.u8(pin.gpio())
-                    .bytes(&frequency_hz.to_be_bytes())
-                    .u8(*duty);
-                cmd::SET_PWM_OUTPUT
-            }
-            Self::GetGripperValue { gripper } => {
-                if let Some(g) = gripper {
-                    w.u8(g.get());
-                }
-                cmd::GET_GRIPPER_VALUE
-            }
-            Self::SetGripperStateNoSpeed { state } => {
-                w.u8(*state as u8);
-                cmd::SET_GRIPPER_STATE
-            }
-            Self::SetGripperState {
-                state,
-                speed,
-                model,
-            } => {
-                w.u8(*state as u8).u8(speed.get());
-                gripper_model(&mut w, *model);
-                cmd::SET_GRIPPER_STATE
-            }
-            Self::SetGripperValue {
-                value,
-                speed,
-                model,
-            } => {
-                w.u8(value.get()).u8(speed.get());
-                gripper_model(&mut w, *model);
-                cmd::SET_GRIPPER_VALUE
-            }
-            Self::SetColor { rgb } => {
-                w.u8(rgb.r).u8(rgb.g).u8(rgb.b);
-                cmd::SET_COLOR
-            }
-            Self::SetHtsGripperTorque { torque } => {
-                w.i16(*torque);
-                cmd::SET_HTS_GRIPPER_TORQUE
-            }
-            Self::SetGripperProtectCurrent { current } => {
-                w.i16(*current);
-                cmd::SET_GRIPPER_PROTECT_CURRENT
-            }
-            Self::SetToolReference { pose } => {
-                w.pose(pose);
-                cmd::SET_TOOL_REFERENCE
-            }
-            Self::SetWorldReference { pose } => {
-                w.pose(pose);
-                cmd::SET_WORLD_REFERENCE
-            }
-            Self::SetReferenceFrame { frame } => {
-                w.u8(*frame as u8);
-                cmd::SET_REFERENCE_FRAME
-            }
-            Self::SetMovementType { mode } => {
-                w.u8(*mode as u8);
-                cmd::SET_MOVEMENT_TYPE
-            }
-            Self::SetEndType { end } => {
-                w.u8(*end as u8);
-                cmd::SET_END_TYPE
-            }
-            Self::SetBasicOutput { pin, high } => {
-                w.u8(pin.gpio()).u8(u8::from(*high));
-                cmd::SET_BASIC_OUTPUT
-            }
-            Self::GetBasicInput { pin } => {
-                w.u8(pin.gpio());
-                cmd::GET_BASIC_INPUT
-            }
-            Self::SetSsidPwd { payload } => {
-                w.bytes(payload);
-                cmd::SET_SSID_PWD
-            }
-            Self::SetServerPort { port } => {
-                w.bytes(&port.to_be_bytes());
-                cmd::SET_SERVER_PORT
-            }
-            Self::SetTransponderMode { mode } => {
-                w.u8(*mode as u8);
-                cmd::SET_TRANSPONDER_MODE
-            }
-            // Every data-less variant returned above through `no_data_code`.
-            _ => 0,
-        };
-        (code, w)
+        self.emit(&mut w);
+        w.frame(self.cmd())
     }
 }
 
@@ -1492,6 +875,58 @@ mod tests {
 
     fn parse(cmd: u8, data: &[u8]) -> Result<Request, CommandError> {
         Request::parse(&Frame::new(cmd, data).unwrap())
+    }
+
+    #[test]
+    fn the_table_gives_every_known_code_a_command_and_no_other() {
+        let codes: std::collections::BTreeSet<u8> =
+            RequestKind::ALL.iter().map(|k| k.cmd()).collect();
+        let known: std::collections::BTreeSet<u8> = cmd::ALL.into_iter().collect();
+        assert_eq!(codes, known, "cmd::ALL and the table of requests disagree");
+        let kinds: std::collections::BTreeSet<String> =
+            RequestKind::ALL.iter().map(|k| format!("{k:?}")).collect();
+        assert_eq!(kinds.len(), RequestKind::ALL.len(), "a kind listed twice");
+    }
+
+    #[test]
+    fn kind_and_cmd_come_from_the_entry_of_the_variant() {
+        assert_eq!(Request::GetAngles.kind(), RequestKind::GetAngles);
+        let to_coords = Request::AnglesToCoords {
+            angles: [Centideg(0); 6],
+        };
+        assert_eq!(to_coords.kind(), RequestKind::AnglesToCoords);
+        // Two layouts of one code: two kinds, one CMD byte.
+        assert_eq!(to_coords.cmd(), cmd::GET_COORDS);
+        assert_eq!(Request::GetCoords.cmd(), cmd::GET_COORDS);
+        assert_eq!(
+            RequestKind::JogStop.cmd(),
+            RequestKind::JogIncrementCoord.cmd()
+        );
+    }
+
+    #[test]
+    fn a_command_without_fields_is_its_bare_frame() {
+        for r in [Request::GetAngles, Request::Stop, Request::DragEndRecord] {
+            let frame = r.to_frame();
+            assert_eq!((frame.cmd(), frame.data()), (r.cmd(), &[][..]));
+            assert_eq!(Request::parse(&frame), Ok(r.clone()));
+            assert!(matches!(
+                parse(r.cmd(), &[0]),
+                Err(CommandError::BadLength { data_len: 1, .. })
+            ));
+        }
+    }
+
+    #[test]
+    fn reply_kind_may_depend_on_the_fields() {
+        let read = |width| Request::GetServoData {
+            servo: ServoId::new(1).unwrap(),
+            address: 56,
+            width,
+        };
+        assert_eq!(read(None).reply_kind(), ReplyKind::Byte);
+        assert_eq!(read(Some(DataWidth::Byte)).reply_kind(), ReplyKind::Byte);
+        assert_eq!(read(Some(DataWidth::Word)).reply_kind(), ReplyKind::Int16);
     }
 
     #[test]

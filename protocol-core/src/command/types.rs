@@ -32,9 +32,6 @@ checked_byte!(
 );
 
 impl JointId {
-    /// Number of arm joints.
-    pub const COUNT: usize = 6;
-
     /// Zero-based index into a six-joint array, 0..=5.
     pub const fn index(self) -> usize {
         self.0 as usize - 1
@@ -53,9 +50,6 @@ checked_byte!(
 );
 
 impl ServoId {
-    /// The gripper servo.
-    pub const GRIPPER: Self = Self(7);
-
     /// The arm joint this servo drives, or `None` for the gripper.
     pub const fn joint(self) -> Option<JointId> {
         JointId::new(self.0)
@@ -126,11 +120,6 @@ impl Axis {
     /// Zero-based index into a pose array (x, y, z, rx, ry, rz).
     pub const fn index(self) -> usize {
         self as usize - 1
-    }
-
-    /// True for x, y, z (tenths of a millimetre); false for rx, ry, rz (centidegrees).
-    pub const fn is_linear(self) -> bool {
-        matches!(self, Self::X | Self::Y | Self::Z)
     }
 }
 

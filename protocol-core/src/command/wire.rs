@@ -18,6 +18,16 @@ impl<'a> Reader<'a> {
         Self { data }
     }
 
+    /// Bytes not read yet.
+    pub(crate) fn remaining(&self) -> usize {
+        self.data.len()
+    }
+
+    /// Every byte not read yet.
+    pub(crate) fn rest(&mut self) -> &'a [u8] {
+        core::mem::take(&mut self.data)
+    }
+
     pub(crate) fn u8(&mut self) -> Option<u8> {
         let (&first, rest) = self.data.split_first()?;
         self.data = rest;
@@ -67,7 +77,8 @@ impl<'a> Reader<'a> {
     }
 }
 
-/// Builds a frame's data; bytes beyond [`MAX_DATA`] are dropped (no layout comes close).
+/// Builds a frame's data; bytes beyond [`MAX_DATA`] are dropped (no layout is longer: only the
+/// free-form payload of 0xB0 reaches it).
 #[derive(Default)]
 pub(crate) struct Writer {
     data: Vec<u8, MAX_DATA>,
