@@ -94,12 +94,17 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
         }
         None => {}
     }
+    let mut robot = VirtualRobot::new(RobotConfig::default()).with_basic_flash(flash);
+    for &obstacle in &cli.obstacles {
+        robot.add_obstacle(obstacle);
+        writeln!(out, "obstacle: {obstacle}")?;
+    }
     writeln!(out, "ready (Ctrl-C to stop)")?;
     out.flush()?;
     drop(out);
 
     let robot = ServedRobot {
-        robot: VirtualRobot::new(RobotConfig::default()).with_basic_flash(flash),
+        robot,
         link: cli.port.into(),
     };
     let mut driver = RealtimeDriver::new(robot, pty, tcp);
@@ -165,18 +170,19 @@ fn serve_emulated(
     if let Some(link) = &link {
         writeln!(out, "pty link {}", link.path().display())?;
     }
+    let mut arm = EmulatedArm::new(
+        RobotConfig::default().seed,
+        RobotConfig::default().initial_position_steps,
+    );
+    for &obstacle in &cli.obstacles {
+        arm.add_obstacle(obstacle);
+        writeln!(out, "obstacle: {obstacle}")?;
+    }
     writeln!(out, "ready (Ctrl-C to stop)")?;
     out.flush()?;
     drop(out);
 
-    let robot = EmulatedBoards::new(
-        EmulatedArm::new(
-            RobotConfig::default().seed,
-            RobotConfig::default().initial_position_steps,
-        ),
-        buses,
-        front,
-    );
+    let robot = EmulatedBoards::new(arm, buses, front);
     RealtimeDriver::new(robot, pty, None).run(&stop)?;
     drop(link);
     let _ = writeln!(std::io::stdout(), "stopped");

@@ -14,6 +14,17 @@
 //! it by hand ([`SimServo::move_by_hand`] at once, [`SimServo::move_by_hand_over`] smoothly over
 //! time, its speed reported as the present speed like the real encoder does), and the goal
 //! follows the present position so re-enabling torque holds the arm still.
+//!
+//! Contact ([`SimServo::add_obstacle`], [`SimServo::push`]): the motion profile gives where the
+//! position loop wants the shaft (the setpoint); the shaft is there unless something holds it.
+//! A rigid stop keeps the shaft on its side; an external torque deflects a held shaft until the
+//! motor's torque balances it, and drives it along once the push is stronger than the torque
+//! limit (register 48). A new goal is planned from where the shaft is. The motor's torque is the position loop's: [`STIFFNESS_PER_P`] x P
+//! (register 21) per step between setpoint and shaft, capped at the torque limit. It shows as
+//! the present load (register 60, thousandths of the maximum torque) and current (69); a load
+//! at or above the overload torque (register 36, percent) for the protection time (register 35,
+//! 10 ms units) trips the overload protection: status bit 32, and the torque cut to the
+//! protective torque (register 34, percent) until torque is switched again (register 40).
 
 use std::collections::VecDeque;
 
@@ -52,6 +63,21 @@ pub const SUPPLY_DECIVOLT: u8 = 120;
 pub const AMBIENT_C: u8 = 32;
 /// Temperature an injected overheat reports, in deg C (above the default limit of 70).
 pub const OVERHEAT_C: u8 = 80;
+
+/// Torque of the position loop per step of error and unit of the P coefficient (register 21),
+/// in thousandths of the maximum torque. Feetech does not publish the scaling; with this one the
+/// arm's factory P of 10 gives full torque 25 steps (2.2 deg) from the setpoint, and joint 4's
+/// P of 32 at 8 steps, as stiff as a hand feels the real joints.
+pub const STIFFNESS_PER_P: f64 = 4.0;
+/// Load of a shaft moving freely (friction and the arm's inertia), thousandths of max torque.
+pub const FREE_MOVING_LOAD: f64 = 180.0;
+/// Load of a shaft holding still with nothing pushing it, thousandths of max torque.
+pub const HOLDING_LOAD: f64 = 40.0;
+/// EEPROM: torque after the overload protection tripped, percent of max (STS3215: 20).
+pub const PROTECTIVE_TORQUE: u8 = 34;
+/// EEPROM: how long a load at the overload torque lasts before the protection trips, 10 ms
+/// units (STS3215: 200, 2 s).
+pub const PROTECTION_TIME: u8 = 35;
 
 /// First RAM address; below it is EEPROM (write-protected by register 55).
 const FIRST_RAM_ADDR: u8 = reg::TORQUE_ENABLE;
@@ -128,6 +154,24 @@ impl HandMove {
     }
 }
 
+/// A rigid stop in the shaft's way: the shaft stays on one side of `raw_steps`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Stop {
+    raw_steps: f64,
+    keeps_below: bool,
+}
+
+impl Stop {
+    /// `position` moved back to this stop's side of it.
+    fn limit(&self, position: f64) -> f64 {
+        if self.keeps_below {
+            position.min(self.raw_steps)
+        } else {
+            position.max(self.raw_steps)
+        }
+    }
+}
+
 /// Counters of what a servo did, for tests and benchmarks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ServoStats {
@@ -191,8 +235,23 @@ impl PacketListener {
 pub struct SimServo {
     table: [u8; reg::TABLE_SIZE],
     raw_position_steps: f64,
+    /// The shaft's speed (the profile's while nothing holds the shaft), steps/s.
     velocity_steps_per_s: f64,
+    /// Where the position loop wants the shaft: the motion profile's position, raw steps.
+    setpoint_steps: f64,
+    /// The motion profile's speed, steps/s.
+    setpoint_velocity: f64,
     last_control_ns: u64,
+    /// Rigid stops in the shaft's way ([`SimServo::add_obstacle`]).
+    stops: Vec<Stop>,
+    /// External torque on the shaft ([`SimServo::push`]), thousandths of max torque.
+    push_permille: f64,
+    /// The motor's torque at the last control step, thousandths of max torque, signed.
+    effort_permille: f64,
+    /// Since when the load is at the overload torque, ns.
+    overloaded_since_ns: Option<u64>,
+    /// The overload protection tripped (cleared by a torque enable write).
+    overload_tripped: bool,
     /// Decoder for [`SimServo::poll`] (standalone use).
     listener: PacketListener,
     /// Status packets waiting for their start time (ns), in order.
@@ -217,7 +276,14 @@ impl SimServo {
             table: [0; reg::TABLE_SIZE],
             raw_position_steps: f64::from(position.min(4095)),
             velocity_steps_per_s: 0.0,
+            setpoint_steps: f64::from(position.min(4095)),
+            setpoint_velocity: 0.0,
             last_control_ns: 0,
+            stops: Vec::new(),
+            push_permille: 0.0,
+            effort_permille: 0.0,
+            overloaded_since_ns: None,
+            overload_tripped: false,
             listener: PacketListener::default(),
             replies: VecDeque::new(),
             registered: None,
@@ -260,6 +326,8 @@ impl SimServo {
         set(reg::CW_DEAD_ZONE, &[1, 1]);
         set(reg::HOMING_OFFSET, &0u16.to_le_bytes());
         set(reg::OPERATING_MODE, &[0]);
+        set(PROTECTIVE_TORQUE, &[20]);
+        set(PROTECTION_TIME, &[200]);
         set(reg::OVERLOAD_TORQUE, &[80]);
         self.table = t;
         self.reset_ram();
@@ -273,7 +341,9 @@ impl SimServo {
         }
         self.set_u16(reg::TORQUE_LIMIT, self.reg_u16(reg::MAX_TORQUE));
         self.set_reg(reg::EEPROM_LOCK, 1);
-        self.velocity_steps_per_s = 0.0;
+        self.overload_tripped = false;
+        self.overloaded_since_ns = None;
+        self.hold_where_it_is();
         let present = self.present_position();
         self.set_u16(reg::GOAL_POSITION, present);
         self.update_present_registers();
@@ -374,8 +444,9 @@ impl SimServo {
     /// Turns the shaft by hand to present position `position` (steps), as a user does in free
     /// mode. Works with torque on too (the servo then pulls back towards its goal).
     pub fn move_by_hand(&mut self, position: u16) {
-        self.raw_position_steps = f64::from(i32::from(position.min(4095)) + self.homing_offset());
-        self.velocity_steps_per_s = 0.0;
+        let raw = f64::from(i32::from(position.min(4095)) + self.homing_offset());
+        self.raw_position_steps = self.stops.iter().fold(raw, |p, stop| stop.limit(p));
+        self.hold_where_it_is();
         if !self.torque_enabled() {
             self.set_u16(reg::GOAL_POSITION, self.present_position());
         }
@@ -400,6 +471,39 @@ impl SimServo {
     /// True while a hand turns the shaft ([`SimServo::move_by_hand_over`]).
     pub fn hand_moving(&self) -> bool {
         self.hand.is_some()
+    }
+
+    /// Puts a rigid stop (an obstacle) at present position `position` (steps, as register 56
+    /// counts them), on the side the shaft is on now (at it: below it): from then on neither the
+    /// motor nor a hand takes the shaft past it. Stops add up; [`SimServo::clear_obstacles`]
+    /// removes them.
+    pub fn add_obstacle(&mut self, position: u16) {
+        let raw_steps = f64::from(i32::from(position.min(4095)) + self.homing_offset());
+        self.stops.push(Stop {
+            raw_steps,
+            keeps_below: self.raw_position_steps <= raw_steps,
+        });
+    }
+
+    /// Removes every stop [`SimServo::add_obstacle`] put in the shaft's way.
+    pub fn clear_obstacles(&mut self) {
+        self.stops.clear();
+    }
+
+    /// Pushes on the shaft with an external torque of `permille` thousandths of the servo's
+    /// maximum torque (positive towards higher steps; 0 lets go), from the next control step
+    /// on. A held shaft gives way until the motor balances the push, and is driven along while
+    /// the push is stronger than the torque limit; a free shaft turns with it.
+    pub fn push(&mut self, permille: i16) {
+        self.push_permille = f64::from(permille.clamp(-3000, 3000));
+    }
+
+    /// True while a stop holds the shaft away from where its position loop wants it.
+    pub fn blocked(&self) -> bool {
+        self.stops.iter().any(|stop| {
+            stop.limit(self.setpoint_steps) != self.setpoint_steps
+                && (stop.raw_steps - self.raw_position_steps).abs() < 0.5
+        })
     }
 
     /// The next instant this servo has something to do on the bus (a reply to start), in ns.
@@ -447,52 +551,159 @@ impl SimServo {
     }
 
     fn control_step(&mut self, dt_s: f64) {
-        let goal = f64::from(i32::from(self.goal_position()) + self.homing_offset());
         if !self.torque_enabled() {
-            // Free: the shaft goes where a hand takes it, and the goal follows the shaft, so
-            // enabling torque holds it where it is.
-            self.velocity_steps_per_s = 0.0;
-            if let Some(hand) = self.hand {
-                let (position, velocity, done) = hand.at(self.last_control_ns);
-                self.raw_position_steps = position;
-                self.velocity_steps_per_s = velocity;
-                if done {
-                    self.hand = None;
-                }
-            }
-            let present = self.present_position();
-            self.set_u16(reg::GOAL_POSITION, present);
+            self.free_step(dt_s);
         } else if self.faults.stall {
             self.velocity_steps_per_s = 0.0;
+            self.setpoint_velocity = 0.0;
         } else {
-            let speed = match self.reg_u16(reg::GOAL_SPEED) & 0x7FFF {
-                0 => MAX_SPEED_STEPS_PER_S,
-                s => f64::from(s).min(MAX_SPEED_STEPS_PER_S),
-            };
-            let accel = match self.reg(reg::ACCELERATION) {
-                0 => MAX_ACCEL_STEPS_PER_S2,
-                a => (f64::from(a) * ACCEL_UNIT_STEPS_PER_S2).min(MAX_ACCEL_STEPS_PER_S2),
-            };
-            let error = goal - self.raw_position_steps;
-            let v = self.velocity_steps_per_s;
-            // Speed we want now: towards the goal, capped so that we can still stop in time.
-            let wanted = error.signum() * speed.min((2.0 * accel * error.abs()).sqrt());
-            let dv = (wanted - v).clamp(-accel * dt_s, accel * dt_s);
-            let mut v_next = v + dv;
-            if error.abs() <= 0.5 && v.abs() <= accel * dt_s {
-                v_next = 0.0;
-            }
-            let step = (v + v_next) / 2.0 * dt_s;
-            if step * error >= 0.0 && step.abs() >= error.abs() {
-                // Arrives within this step: the position loop holds it there (no overshoot).
-                self.raw_position_steps = goal;
-                self.velocity_steps_per_s = 0.0;
-            } else {
-                self.raw_position_steps += step;
-                self.velocity_steps_per_s = v_next;
-            }
+            self.profile_step(dt_s);
+            self.shaft_step(dt_s);
         }
+        self.update_overload();
         self.update_present_registers();
+    }
+
+    /// Free shaft: it goes where a hand or a push takes it, and the goal follows it, so
+    /// enabling torque holds it where it is.
+    fn free_step(&mut self, dt_s: f64) {
+        self.velocity_steps_per_s = 0.0;
+        if let Some(hand) = self.hand {
+            let (position, velocity, done) = hand.at(self.last_control_ns);
+            self.raw_position_steps = position;
+            self.velocity_steps_per_s = velocity;
+            if done {
+                self.hand = None;
+            }
+        } else if self.push_permille != 0.0 {
+            self.velocity_steps_per_s = (self.push_permille / 1000.0 * MAX_SPEED_STEPS_PER_S)
+                .clamp(-MAX_SPEED_STEPS_PER_S, MAX_SPEED_STEPS_PER_S);
+            self.raw_position_steps += self.velocity_steps_per_s * dt_s;
+        }
+        let shaft = self.stopped(self.raw_position_steps);
+        if shaft != self.raw_position_steps {
+            self.raw_position_steps = shaft;
+            self.velocity_steps_per_s = 0.0;
+        }
+        self.setpoint_steps = self.raw_position_steps;
+        self.setpoint_velocity = 0.0;
+        self.effort_permille = 0.0;
+        let present = self.present_position();
+        self.set_u16(reg::GOAL_POSITION, present);
+    }
+
+    /// The motion profile: the setpoint towards the goal with the goal speed and acceleration.
+    fn profile_step(&mut self, dt_s: f64) {
+        let goal = f64::from(i32::from(self.goal_position()) + self.homing_offset());
+        let speed = match self.reg_u16(reg::GOAL_SPEED) & 0x7FFF {
+            0 => MAX_SPEED_STEPS_PER_S,
+            s => f64::from(s).min(MAX_SPEED_STEPS_PER_S),
+        };
+        let accel = match self.reg(reg::ACCELERATION) {
+            0 => MAX_ACCEL_STEPS_PER_S2,
+            a => (f64::from(a) * ACCEL_UNIT_STEPS_PER_S2).min(MAX_ACCEL_STEPS_PER_S2),
+        };
+        let error = goal - self.setpoint_steps;
+        let v = self.setpoint_velocity;
+        // Speed we want now: towards the goal, capped so that we can still stop in time.
+        let wanted = error.signum() * speed.min((2.0 * accel * error.abs()).sqrt());
+        let dv = (wanted - v).clamp(-accel * dt_s, accel * dt_s);
+        let mut v_next = v + dv;
+        if error.abs() <= 0.5 && v.abs() <= accel * dt_s {
+            v_next = 0.0;
+        }
+        let step = (v + v_next) / 2.0 * dt_s;
+        if step * error >= 0.0 && step.abs() >= error.abs() {
+            // Arrives within this step: the position loop holds it there (no overshoot).
+            self.setpoint_steps = goal;
+            self.setpoint_velocity = 0.0;
+        } else {
+            self.setpoint_steps += step;
+            self.setpoint_velocity = v_next;
+        }
+    }
+
+    /// The shaft under the motor: at the setpoint unless a push deflects it or a stop holds it;
+    /// the motor's torque is the position loop's, capped at the torque limit.
+    fn shaft_step(&mut self, dt_s: f64) {
+        let before = self.raw_position_steps;
+        let stiffness = STIFFNESS_PER_P * f64::from(self.reg(reg::P_COEFFICIENT).max(1));
+        let limit = self.torque_limit_permille();
+        let push = self.push_permille;
+        let wanted = if push.abs() <= limit {
+            // The shaft gives way until the motor's torque balances the push.
+            self.setpoint_steps + push / stiffness
+        } else {
+            // Stronger than the motor: the push drives the shaft along, against the full torque.
+            let speed = (push.abs() - limit) / 1000.0 * MAX_SPEED_STEPS_PER_S;
+            let held = self.setpoint_steps + push.signum() * limit / stiffness;
+            let driven = before + push.signum() * speed * dt_s;
+            if push > 0.0 {
+                driven.max(held)
+            } else {
+                driven.min(held)
+            }
+        };
+        let shaft = self.stopped(wanted);
+        self.raw_position_steps = shaft;
+        self.effort_permille = (stiffness * (self.setpoint_steps - shaft)).clamp(-limit, limit);
+        self.velocity_steps_per_s = if shaft == self.setpoint_steps {
+            self.setpoint_velocity
+        } else {
+            (shaft - before) / dt_s
+        };
+    }
+
+    /// `position` moved back to the allowed side of every stop.
+    fn stopped(&self, position: f64) -> f64 {
+        self.stops.iter().fold(position, |p, stop| stop.limit(p))
+    }
+
+    /// The torque the motor may give now, thousandths of max: the torque limit (register 48),
+    /// or the protective torque (register 34) once the overload protection tripped.
+    fn torque_limit_permille(&self) -> f64 {
+        let limit = f64::from(self.reg_u16(reg::TORQUE_LIMIT).min(1000));
+        if self.overload_tripped {
+            limit.min(f64::from(self.reg(PROTECTIVE_TORQUE)) * 10.0)
+        } else {
+            limit
+        }
+    }
+
+    /// The present load, thousandths of max torque, without its sign.
+    fn load_permille(&self) -> f64 {
+        if !self.torque_enabled() {
+            return 0.0;
+        }
+        let base = if self.velocity_steps_per_s.round() != 0.0 {
+            FREE_MOVING_LOAD
+        } else {
+            HOLDING_LOAD
+        };
+        (base + self.effort_permille.abs()).min(self.torque_limit_permille().max(base))
+    }
+
+    /// Trips the overload protection after a load at the overload torque (register 36) that
+    /// lasted the protection time (register 35).
+    fn update_overload(&mut self) {
+        let threshold = f64::from(self.reg(reg::OVERLOAD_TORQUE)) * 10.0;
+        if self.torque_enabled() && !self.faults.stall && self.load_permille() >= threshold {
+            let since = *self.overloaded_since_ns.get_or_insert(self.last_control_ns);
+            let protection_ns = u64::from(self.reg(PROTECTION_TIME)) * 10_000_000;
+            if self.last_control_ns.saturating_sub(since) >= protection_ns {
+                self.overload_tripped = true;
+            }
+        } else {
+            self.overloaded_since_ns = None;
+        }
+    }
+
+    /// The shaft and the setpoint at rest where the shaft is.
+    fn hold_where_it_is(&mut self) {
+        self.velocity_steps_per_s = 0.0;
+        self.setpoint_steps = self.raw_position_steps;
+        self.setpoint_velocity = 0.0;
+        self.effort_permille = 0.0;
     }
 
     fn homing_offset(&self) -> i32 {
@@ -522,15 +733,13 @@ impl SimServo {
         let speed = self.velocity_steps_per_s.round() as i16;
         let load_permille: i16 = if stalled {
             980
-        } else if !torque {
-            0
-        } else if speed != 0 {
-            180
         } else {
-            40
+            self.load_permille().round() as i16
         };
         let direction = if stalled {
             i16::from(goal >= present) * 2 - 1
+        } else if self.effort_permille != 0.0 {
+            if self.effort_permille > 0.0 { 1 } else { -1 }
         } else if speed < 0 {
             -1
         } else {
@@ -538,7 +747,7 @@ impl SimServo {
         };
         let moving = torque && (speed != 0 || goal.abs_diff(present) > 1);
         let mut status = 0;
-        if stalled {
+        if stalled || (self.overload_tripped && torque) {
             status |= fault::OVERLOAD;
         }
         if self.faults.overheat {
@@ -685,6 +894,10 @@ impl SimServo {
             }
         }
         if goal_written {
+            // A new goal is planned from where the shaft is (a stop may hold it short of the
+            // old setpoint), at the speed it turns.
+            self.setpoint_steps = self.raw_position_steps;
+            self.setpoint_velocity = self.velocity_steps_per_s;
             self.stats.goal_writes += 1;
             let min = self.reg_u16(reg::MIN_POSITION);
             let max = self.reg_u16(reg::MAX_POSITION);
@@ -710,13 +923,15 @@ impl SimServo {
             }
             0 | 2 => {
                 self.set_reg(reg::TORQUE_ENABLE, value);
-                self.velocity_steps_per_s = 0.0;
+                self.overload_tripped = false;
+                self.hold_where_it_is();
                 let present = self.present_position();
                 self.set_u16(reg::GOAL_POSITION, present);
             }
             _ => {
                 // The servo holds the shaft: a hand turning it lets go.
                 self.hand = None;
+                self.overload_tripped = false;
                 if !self.torque_enabled() {
                     let present = self.present_position();
                     self.set_u16(reg::GOAL_POSITION, present);
@@ -1333,5 +1548,107 @@ mod tests {
         bytes.extend_from_slice(&Instruction::Ping.to_packet(1).unwrap().to_bytes());
         let trace = rig.exchange_bytes(&bytes);
         assert_eq!(rig.answers(&trace).len(), 1);
+    }
+
+    /// Present position, signed load and status register of servo 1.
+    fn position_load_status(rig: &mut Rig) -> (u16, i16, u8) {
+        let state = rig.read(1, reg::STATE_BLOCK, reg::STATE_BLOCK_LEN).unwrap();
+        (
+            state.u16_at(0).unwrap(),
+            sign_magnitude(state.u16_at(4).unwrap(), 10),
+            state.params()[9],
+        )
+    }
+
+    #[test]
+    fn an_obstacle_stops_the_shaft_and_the_load_rises_to_the_torque_limit() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        rig.servo(0).add_obstacle(2300);
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 3000, 1000));
+        rig.run_for_ms(100);
+        let (position, load, _) = position_load_status(&mut rig);
+        assert!(position < 2300, "still on its way: {position}");
+        assert!(load < 300, "moving freely: {load}");
+        rig.run_for_ms(900);
+        let (position, load, status) = position_load_status(&mut rig);
+        assert_eq!(position, 2300, "held at the stop");
+        assert!(load >= 990, "pressing with full torque: {load}");
+        assert_eq!(status & fault::OVERLOAD, 0, "not yet tripped");
+        assert!(rig.servo(0).is_moving() && rig.servo(0).blocked());
+    }
+
+    #[test]
+    fn pressing_on_trips_the_overload_protection_after_its_time() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        rig.servo(0).add_obstacle(2100);
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 2600, 0));
+        rig.run_for_ms(1900);
+        assert_eq!(position_load_status(&mut rig).2 & fault::OVERLOAD, 0);
+        rig.run_for_ms(300);
+        let (position, load, status) = position_load_status(&mut rig);
+        assert_eq!(
+            status & fault::OVERLOAD,
+            fault::OVERLOAD,
+            "tripped after 2 s"
+        );
+        assert_eq!((position, load), (2100, 200), "protective torque only");
+        // Switching torque again clears it; a goal where the shaft stands presses no more.
+        rig.write(1, reg::TORQUE_ENABLE, &[0]);
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        rig.run_for_ms(10);
+        let (position, load, status) = position_load_status(&mut rig);
+        assert_eq!((position, status & fault::OVERLOAD), (2100, 0));
+        assert!(load < 100, "holding without pressing: {load}");
+    }
+
+    #[test]
+    fn setting_the_goal_back_unloads_the_shaft_and_it_moves_away_freely() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        rig.servo(0).add_obstacle(1800);
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 1000, 0));
+        rig.run_for_ms(500);
+        assert_eq!(position_load_status(&mut rig).0, 1800);
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 1800, 0));
+        rig.run_for_ms(300);
+        let (_, load, _) = position_load_status(&mut rig);
+        assert!(load.abs() < 100, "no more pressing: {load}");
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 2500, 0));
+        rig.run_for_ms(600);
+        assert_eq!(position_load_status(&mut rig).0, 2500, "away from the stop");
+    }
+
+    #[test]
+    fn a_push_deflects_a_held_shaft_until_the_motor_balances_it() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        // Factory P of servo 1 is 10: 40 thousandths of max torque per step.
+        rig.servo(0).push(-400);
+        rig.run_for_ms(50);
+        let (position, load, _) = position_load_status(&mut rig);
+        assert_eq!(position, 2038, "gives 10 steps");
+        assert!((400..=450).contains(&load), "holds against it: {load}");
+        // Stronger than the torque limit: the shaft is driven along.
+        rig.servo(0).push(1500);
+        rig.run_for_ms(100);
+        let (position, load, _) = position_load_status(&mut rig);
+        assert!(position > 2100, "driven: {position}");
+        assert!(load <= -990, "full torque against the push: {load}");
+        rig.servo(0).push(0);
+        rig.run_for_ms(600);
+        assert_eq!(position_load_status(&mut rig).0, 2048, "back at its goal");
+    }
+
+    #[test]
+    fn a_hand_cannot_take_a_free_shaft_through_an_obstacle() {
+        let mut rig = Rig::new(&[1]);
+        rig.servo(0).add_obstacle(2200);
+        rig.servo(0).move_by_hand(2500);
+        assert_eq!(rig.servo(0).present_position(), 2200);
+        rig.servo(0).clear_obstacles();
+        rig.servo(0).move_by_hand(2500);
+        assert_eq!(rig.servo(0).present_position(), 2500);
     }
 }

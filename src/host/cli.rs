@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::{Parser, ValueEnum};
 
 use crate::sim::HostLink;
+use crate::sim::contact::Obstacle;
 
 /// Virtual myCobot 280 M5: the real Basic and Atom firmware logic, simulated servos, served in
 /// real time on a pseudo-terminal (and optionally TCP) to pymycobot or any serial client, with
@@ -46,6 +47,12 @@ pub struct Cli {
     /// Do not serve the 3D view.
     #[arg(long)]
     pub no_web: bool,
+    /// A rigid obstacle in joint J's way at DEG degrees (repeatable): the joint cannot move past
+    /// it from the side it starts on, e.g. `--obstacle 2:-30`. The firmware feels it only
+    /// through what the joint's servo reports, as on the real arm.
+    #[arg(long = "obstacle", value_name = "J:DEG", allow_hyphen_values = true)]
+    pub obstacles: Vec<Obstacle>,
+
     /// The Atom is an emulated chip running the real image (tools/emulate, docs/boards.md
     /// "Emulated boards"): its bus UART (UART1) is the socket at ADDR:PORT (QEMU
     /// `-serial tcp:ADDR:PORT,server=on`), on the simulated wire in place of the host-built Atom.
@@ -131,6 +138,12 @@ mod tests {
         assert_eq!(HostLink::from(atom.port), HostLink::AtomUsb);
 
         assert!(Cli::try_parse_from(["open-mycobot", "--tcp", "9000"]).is_err());
+
+        let blocked = ["open-mycobot", "--obstacle", "2:-30", "--obstacle", "1:45"];
+        let blocked = Cli::try_parse_from(blocked).unwrap();
+        assert_eq!(blocked.obstacles.len(), 2);
+        assert_eq!(blocked.obstacles[0].angle.0, -3000);
+        assert!(Cli::try_parse_from(["open-mycobot", "--obstacle", "9:10"]).is_err());
     }
 
     #[test]

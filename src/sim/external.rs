@@ -26,9 +26,11 @@
 
 use protocol_core::BytePort;
 
+use super::contact::Obstacle;
 use super::robot::SERVO_IDS;
 use super::servo::SimServo;
 use super::wire::{Bus, HeardByte, StationId};
+use firmware_atom::AtomConfig;
 use sim_hw::ServoChain;
 
 /// How long the bytes of an unfinished frame wait for the rest before they go on the wire as
@@ -189,6 +191,12 @@ impl EmulatedArm {
             heard: Vec::new(),
         });
         BoardId(self.boards.len() - 1)
+    }
+
+    /// Puts `obstacle` in its joint's way, with the joints mapped onto servos as the Atom's
+    /// default configuration does (the emulated Atom runs it); `false` if there is no such servo.
+    pub fn add_obstacle(&mut self, obstacle: Obstacle) -> bool {
+        obstacle.place(&mut self.servos, &AtomConfig::default())
     }
 
     /// Virtual time, in microseconds.

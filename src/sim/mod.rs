@@ -36,6 +36,7 @@
 //! ```
 
 mod basic_flash;
+pub mod contact;
 pub mod external;
 pub mod measure;
 mod robot;

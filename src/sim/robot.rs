@@ -11,6 +11,7 @@ use protocol_core::units::{Centideg, Steps};
 use protocol_core::{Frame, FrameDecoder};
 
 use super::basic_flash::BasicFlashStore;
+use super::contact::Obstacle;
 use super::servo::SimServo;
 use super::wire::{Bus, HeardByte, SerialLine, SerialPort, StationId};
 use sim_hw::ServoChain;
@@ -674,6 +675,37 @@ impl VirtualRobot {
         match self.servos.get_mut(id) {
             Some(servo) => {
                 servo.move_by_hand_over(position, now, duration_us.saturating_mul(1_000));
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Puts `obstacle` in its joint's way ([`Obstacle`]); `false` if that joint has no servo.
+    pub fn add_obstacle(&mut self, obstacle: Obstacle) -> bool {
+        obstacle.place(&mut self.servos, self.atom.config())
+    }
+
+    /// Pushes joint `joint` (1..=6) with an external torque of `permille` thousandths of its
+    /// servo's maximum torque, towards higher angles for a positive value (0 lets go):
+    /// someone leaning on the arm ([`SimServo::push`]). `false` if there is no such joint.
+    pub fn push_joint(&mut self, joint: u8, permille: i16) -> bool {
+        if !(1..=6).contains(&joint) {
+            return false;
+        }
+        let config = self.atom.config();
+        let towards_higher_steps = match config.joint_signs.get(usize::from(joint).wrapping_sub(1))
+        {
+            Some(firmware_atom::JointSign::Negative) => permille.saturating_neg(),
+            _ => permille,
+        };
+        let id = config
+            .servo_ids
+            .get(usize::from(joint).wrapping_sub(1))
+            .copied();
+        match id.and_then(|id| self.servos.get_mut(id)) {
+            Some(servo) => {
+                servo.push(towards_higher_steps);
                 true
             }
             None => false,
