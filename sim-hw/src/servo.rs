@@ -21,7 +21,8 @@
 //! motor's torque balances it, and drives it along once the push is stronger than the torque
 //! limit (register 48). A new goal is planned from where the shaft is. The motor's torque is the position loop's: [`STIFFNESS_PER_P`] x P
 //! (register 21) per step between setpoint and shaft, capped at the torque limit. It shows as
-//! the present load (register 60, thousandths of the maximum torque) and current (69); a load
+//! the present load (register 60, thousandths of the maximum torque; a moving shaft adds
+//! [`FREE_MOVING_LOAD`] and its inertia, [`INERTIA_LOAD_AT_MAX_ACCEL`] at full acceleration) and current (69); a load
 //! at or above the overload torque (register 36, percent) for the protection time (register 35,
 //! 10 ms units) trips the overload protection: status bit 32, and the torque cut to the
 //! protective torque (register 34, percent) until torque is switched again (register 40).
@@ -73,6 +74,9 @@ pub const STIFFNESS_PER_P: f64 = 4.0;
 pub const FREE_MOVING_LOAD: f64 = 180.0;
 /// Load of a shaft holding still with nothing pushing it, thousandths of max torque.
 pub const HOLDING_LOAD: f64 = 40.0;
+/// Extra load of speeding the arm up or slowing it down at [`MAX_ACCEL_STEPS_PER_S2`],
+/// thousandths of max torque (in proportion below it): the inertia the motor must overcome.
+pub const INERTIA_LOAD_AT_MAX_ACCEL: f64 = 200.0;
 /// EEPROM: torque after the overload protection tripped, percent of max (STS3215: 20).
 pub const PROTECTIVE_TORQUE: u8 = 34;
 /// EEPROM: how long a load at the overload torque lasts before the protection trips, 10 ms
@@ -241,6 +245,8 @@ pub struct SimServo {
     setpoint_steps: f64,
     /// The motion profile's speed, steps/s.
     setpoint_velocity: f64,
+    /// The motion profile's acceleration at the last control step, steps/s^2.
+    setpoint_accel: f64,
     last_control_ns: u64,
     /// Rigid stops in the shaft's way ([`SimServo::add_obstacle`]).
     stops: Vec<Stop>,
@@ -278,6 +284,7 @@ impl SimServo {
             velocity_steps_per_s: 0.0,
             setpoint_steps: f64::from(position.min(4095)),
             setpoint_velocity: 0.0,
+            setpoint_accel: 0.0,
             last_control_ns: 0,
             stops: Vec::new(),
             push_permille: 0.0,
@@ -554,8 +561,7 @@ impl SimServo {
         if !self.torque_enabled() {
             self.free_step(dt_s);
         } else if self.faults.stall {
-            self.velocity_steps_per_s = 0.0;
-            self.setpoint_velocity = 0.0;
+            self.hold_where_it_is();
         } else {
             self.profile_step(dt_s);
             self.shaft_step(dt_s);
@@ -587,6 +593,7 @@ impl SimServo {
         }
         self.setpoint_steps = self.raw_position_steps;
         self.setpoint_velocity = 0.0;
+        self.setpoint_accel = 0.0;
         self.effort_permille = 0.0;
         let present = self.present_position();
         self.set_u16(reg::GOAL_POSITION, present);
@@ -605,6 +612,7 @@ impl SimServo {
         };
         let error = goal - self.setpoint_steps;
         let v = self.setpoint_velocity;
+        let before = v;
         // Speed we want now: towards the goal, capped so that we can still stop in time.
         let wanted = error.signum() * speed.min((2.0 * accel * error.abs()).sqrt());
         let dv = (wanted - v).clamp(-accel * dt_s, accel * dt_s);
@@ -621,6 +629,7 @@ impl SimServo {
             self.setpoint_steps += step;
             self.setpoint_velocity = v_next;
         }
+        self.setpoint_accel = (self.setpoint_velocity - before) / dt_s;
     }
 
     /// The shaft under the motor: at the setpoint unless a push deflects it or a stop holds it;
@@ -677,6 +686,8 @@ impl SimServo {
         }
         let base = if self.velocity_steps_per_s.round() != 0.0 {
             FREE_MOVING_LOAD
+                + INERTIA_LOAD_AT_MAX_ACCEL
+                    * (self.setpoint_accel.abs() / MAX_ACCEL_STEPS_PER_S2).min(1.0)
         } else {
             HOLDING_LOAD
         };
@@ -701,6 +712,7 @@ impl SimServo {
     /// The shaft and the setpoint at rest where the shaft is.
     fn hold_where_it_is(&mut self) {
         self.velocity_steps_per_s = 0.0;
+        self.setpoint_accel = 0.0;
         self.setpoint_steps = self.raw_position_steps;
         self.setpoint_velocity = 0.0;
         self.effort_permille = 0.0;
@@ -1639,6 +1651,19 @@ mod tests {
         rig.servo(0).push(0);
         rig.run_for_ms(600);
         assert_eq!(position_load_status(&mut rig).0, 2048, "back at its goal");
+    }
+
+    #[test]
+    fn speeding_up_loads_the_motor_more_than_cruising() {
+        let mut rig = Rig::new(&[1]);
+        rig.write(1, reg::TORQUE_ENABLE, &[1]);
+        rig.write(1, reg::MOVE_BLOCK, &move_block(0, 4000, 2000));
+        rig.run_for_ms(20);
+        let (_, speeding_up, _) = position_load_status(&mut rig);
+        rig.run_for_ms(300);
+        let (_, cruising, _) = position_load_status(&mut rig);
+        assert!(speeding_up >= 350, "inertia at full acceleration: {speeding_up}");
+        assert_eq!(cruising, 180, "friction alone at a steady speed");
     }
 
     #[test]
