@@ -63,6 +63,7 @@ mod atom;
 pub mod backup;
 mod bank;
 pub mod cartesian;
+pub mod collision;
 mod commands;
 pub mod config;
 pub mod context;

@@ -1662,7 +1662,10 @@ mod tests {
         let (_, speeding_up, _) = position_load_status(&mut rig);
         rig.run_for_ms(300);
         let (_, cruising, _) = position_load_status(&mut rig);
-        assert!(speeding_up >= 350, "inertia at full acceleration: {speeding_up}");
+        assert!(
+            speeding_up >= 350,
+            "inertia at full acceleration: {speeding_up}"
+        );
         assert_eq!(cruising, 180, "friction alone at a steady speed");
     }
 
