@@ -4,23 +4,89 @@
 
 mod sim_support;
 
+use open_mycobot::sim::VirtualRobot;
 use open_mycobot::sim::contact::Obstacle;
-use protocol_core::command::{JointId, Request};
+use protocol_core::Frame;
+use protocol_core::command::{JointId, Reply, Request};
 use protocol_core::units::Centideg;
 use sim_support::*;
 
-#[test]
-fn a_joint_stops_at_an_obstacle_and_the_firmware_reads_where_it_stands() {
+/// Switches collision protection on or off (0x74) and checks it was taken.
+fn protection(robot: &mut VirtualRobot, on: bool) {
+    let set = Frame::new(0x74, &[u8::from(on)]).unwrap();
+    let answer = robot.transact(&set).expect("an answer");
+    assert_eq!(answer.data(), &[1]);
+}
+
+/// Joint 2 to `centideg` at speed 50.
+fn joint_2_to(centideg: i16) -> Request {
+    Request::SendAngle {
+        joint: JointId::new(2).unwrap(),
+        angle: Centideg(centideg),
+        speed: speed(50),
+    }
+}
+
+/// The arm with an obstacle in joint 2's way at 30 degrees.
+fn blocked_at_30() -> VirtualRobot {
     let mut robot = arm();
     assert!(robot.add_obstacle("2:30".parse::<Obstacle>().unwrap()));
-    ack(
-        &mut robot,
-        Request::SendAngle {
-            joint: JointId::new(2).unwrap(),
-            angle: Centideg(6_000),
-            speed: speed(50),
-        },
-    );
+    robot
+}
+
+#[test]
+fn a_move_into_an_obstacle_is_stopped_as_a_collision_until_cleared() {
+    let mut robot = blocked_at_30();
+    let to_60 = joint_2_to(6_000);
+    ack(&mut robot, to_60.clone());
+    assert!(robot.run_until_true(3_000_000, |r| r.atom().collision().is_some()));
+    let collision = robot.atom().collision().unwrap();
+    assert_eq!((collision.joint, collision.code()), (1, 16));
+    wait_until_stopped(&mut robot);
+    assert_eq!(ask(&mut robot, Request::GetErrorInfo), Reply::Byte(16));
+    // Stopped at the obstacle, pressing no more.
+    let at = get_angles(&mut robot)[1].0;
+    assert!((at - 3_000).abs() <= 20, "{at}");
+    let servo = robot.servo(2).unwrap();
+    assert!(!servo.blocked(), "the goal was set back where it stands");
+    // Further motion is refused with the code until cleared.
+    let refused = robot.transact(&to_60.to_frame()).expect("an answer");
+    assert_eq!(refused.data(), &[0], "refused");
+    assert_eq!(ask(&mut robot, Request::GetErrorInfo), Reply::Byte(16));
+    ack(&mut robot, Request::ClearErrorInfo);
+    assert_eq!(ask(&mut robot, Request::GetErrorInfo), Reply::Byte(0));
+    ack(&mut robot, joint_2_to(-1_000));
+    wait_until_stopped(&mut robot);
+    assert!((get_angles(&mut robot)[1].0 + 1_000).abs() <= ANGLE_TOLERANCE);
+    assert_eq!(robot.atom().collision(), None);
+}
+
+#[test]
+fn a_push_on_a_holding_arm_is_a_collision_too() {
+    let mut robot = arm();
+    robot.run_for(500_000);
+    assert!(robot.push_joint(3, 800));
+    assert!(robot.run_until_true(1_000_000, |r| r.atom().collision().is_some()));
+    assert_eq!(robot.atom().collision().unwrap().code(), 18);
+    assert_eq!(ask(&mut robot, Request::GetErrorInfo), Reply::Byte(18));
+}
+
+#[test]
+fn with_protection_off_the_arm_presses_on_as_before() {
+    let mut robot = blocked_at_30();
+    protection(&mut robot, false);
+    ack(&mut robot, joint_2_to(6_000));
+    robot.run_for(1_000_000);
+    assert_eq!(robot.atom().collision(), None);
+    assert!(robot.servo(2).unwrap().blocked(), "still pressing");
+    assert_eq!(ask(&mut robot, Request::GetErrorInfo), Reply::Byte(0));
+}
+
+#[test]
+fn a_joint_stops_at_an_obstacle_and_the_firmware_reads_where_it_stands() {
+    let mut robot = blocked_at_30();
+    protection(&mut robot, false);
+    ack(&mut robot, joint_2_to(6_000));
     robot.run_for(3_000_000);
     let measured = robot.measured_angles()[1];
     assert!(
@@ -32,14 +98,7 @@ fn a_joint_stops_at_an_obstacle_and_the_firmware_reads_where_it_stands() {
         "get_angles reports where it stands"
     );
     // Away from the obstacle it moves as before.
-    ack(
-        &mut robot,
-        Request::SendAngle {
-            joint: JointId::new(2).unwrap(),
-            angle: Centideg(-1_000),
-            speed: speed(50),
-        },
-    );
+    ack(&mut robot, joint_2_to(-1_000));
     wait_until_stopped(&mut robot);
     assert!((get_angles(&mut robot)[1].0 + 1_000).abs() <= ANGLE_TOLERANCE);
 }
@@ -47,6 +106,7 @@ fn a_joint_stops_at_an_obstacle_and_the_firmware_reads_where_it_stands() {
 #[test]
 fn a_push_on_a_held_joint_gives_way_a_little_and_a_strong_one_moves_it() {
     let mut robot = arm();
+    protection(&mut robot, false);
     assert!(robot.push_joint(3, 300));
     robot.run_for(200_000);
     let gave = robot.measured_angles()[2].0;
@@ -62,4 +122,29 @@ fn a_push_on_a_held_joint_gives_way_a_little_and_a_strong_one_moves_it() {
         "let go, it returns to its goal: {back}"
     );
     assert!(!robot.push_joint(7, 100), "no joint 7");
+}
+
+/// The data of the Atom's answer to `cmd` with `data`.
+fn answer(robot: &mut VirtualRobot, cmd: u8, data: &[u8]) -> Vec<u8> {
+    let frame = Frame::new(cmd, data).unwrap();
+    robot.transact(&frame).expect("an answer").data().to_vec()
+}
+
+#[test]
+fn settings_are_taken_in_range_refused_outside_and_survive_a_restart() {
+    let mut robot = arm();
+    assert_eq!(answer(&mut robot, 0xFD, &[]), [1], "on by default");
+    assert_eq!(answer(&mut robot, 0x76, &[]), [100; 6]);
+    for bad in [&[0u8, 100][..], &[7, 100], &[1, 49], &[1, 251]] {
+        assert_eq!(answer(&mut robot, 0x75, bad), [0], "{bad:?}");
+    }
+    assert_eq!(answer(&mut robot, 0x74, &[2]), [0]);
+    assert_eq!(answer(&mut robot, 0x76, &[]), [100; 6], "nothing changed");
+    assert_eq!(answer(&mut robot, 0x75, &[3, 250]), [1]);
+    assert_eq!(answer(&mut robot, 0x75, &[6, 50]), [1]);
+    assert_eq!(answer(&mut robot, 0x74, &[0]), [1]);
+    robot.reset_atom();
+    robot.run_for(1_000_000);
+    assert_eq!(answer(&mut robot, 0xFD, &[]), [0]);
+    assert_eq!(answer(&mut robot, 0x76, &[]), [100, 100, 250, 100, 100, 50]);
 }

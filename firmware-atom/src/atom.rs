@@ -17,6 +17,7 @@
 use protocol_core::units::{Centideg, Steps};
 use protocol_core::{BytePort, Frame};
 
+use crate::collision::{Collision, CollisionSettings};
 use crate::config::{AtomConfig, ConfigError, JOINTS, JointLimit};
 use crate::context::Context;
 use crate::driver::{Op, Outcome};
@@ -35,6 +36,8 @@ pub struct Atom {
     usb: UsbLink,
     button_was_pressed: bool,
     config_error: Option<ConfigError>,
+    /// The settings kept in flash were loaded (at the first poll, where the store is lent).
+    stored_settings_loaded: bool,
 }
 
 impl Atom {
@@ -52,6 +55,7 @@ impl Atom {
             usb: UsbLink::new(),
             button_was_pressed: false,
             config_error,
+            stored_settings_loaded: false,
         }
     }
 
@@ -67,6 +71,10 @@ impl Atom {
         io: &mut I,
     ) {
         self.polled_us = now_us;
+        if !self.stored_settings_loaded {
+            self.stored_settings_loaded = true;
+            self.load_stored_settings(io);
+        }
         for _ in 0..READ_BUDGET {
             let Some(byte) = bus.read_byte() else { break };
             for event in self.schedule.hear(now_us, byte) {
@@ -80,6 +88,7 @@ impl Atom {
         if let Some((op, outcome)) = self.schedule.poll_driver(now_us, bus) {
             self.finish(now_us, op, outcome, usb, io);
         }
+        self.parts.watch_collisions(now_us);
         let p = &mut self.parts;
         let moved = p
             .motion
@@ -167,6 +176,14 @@ impl Atom {
         }
     }
 
+    /// Takes over the settings kept in the flash the board lends (collision protection); without
+    /// a store or a valid record the defaults stay.
+    fn load_stored_settings<I: AtomIo>(&mut self, io: &mut I) {
+        if let Some(stored) = io.param_store().and_then(CollisionSettings::load) {
+            *self.parts.settings.collision_mut() = stored;
+        }
+    }
+
     /// Free mode: the button releases the joints while held (to move the arm by hand).
     fn update_button<I: AtomIo>(&mut self, _now_us: u64, io: &mut I) {
         let pressed = io.button_pressed();
@@ -202,6 +219,11 @@ impl Atom {
     /// True while the arm moves (a motion runs or a joint reports moving).
     pub fn is_moving(&self) -> bool {
         self.parts.is_moving(self.polled_us)
+    }
+
+    /// The collision detected and not cleared yet (0x08, 0x10 clear it).
+    pub fn collision(&self) -> Option<Collision> {
+        self.parts.collision.collision()
     }
 
     /// The error code 0x07 reports (0 = none).

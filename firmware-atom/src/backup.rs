@@ -4,8 +4,7 @@
 //! `BLOCK_ADDR + BLOCK_LEN` (9..=39: angle limits, temperature, voltage and torque limits,
 //! PID, start-up force, dead zones, protection settings, homing offset, operating mode, speed
 //! loop gains: what a replaced or corrupted servo needs), and stores it under the servo's id in
-//! a wear-levelled flash store ([`ParamStore`], `flash_store` on the board and in the virtual
-//! robot). It survives a power cycle. The reply waits for every block to be read and stored
+//! the Atom's flash ([`ParamStore`], `flash_store` on the board and in the virtual robot). It survives a power cycle. The reply waits for every block to be read and stored
 //! ([`crate::waiting`]): `01`, or `00` if a servo did not answer or the flash failed.
 //!
 //! A restore writes a stored block back (EEPROM unlocked and locked around it), after the same
@@ -16,10 +15,7 @@
 //! and stays released until powered on or focused again, which holds it where it is. The
 //! joint limits still apply to every goal afterwards.
 
-use core::ops::Range;
-
-use embedded_storage::nor_flash::NorFlash;
-use flash_store::{FlashRange, StoreError};
+use flash_store::StoreError;
 use protocol_core::command::ServoSelect;
 use protocol_core::servo::{Packet, reg};
 
@@ -28,6 +24,7 @@ use crate::context::Context;
 use crate::driver::Op;
 use crate::error::AtomError;
 use crate::motion::MotionController;
+use crate::store::ParamStore;
 
 /// First register of the parameter block.
 pub const BLOCK_ADDR: u8 = reg::MIN_POSITION;
@@ -42,50 +39,14 @@ const HOMING_OFFSET_AT: usize = (reg::HOMING_OFFSET - BLOCK_ADDR) as usize;
 /// Offset of the operating mode (register 33) in a block.
 const MODE_AT: usize = (reg::OPERATING_MODE - BLOCK_ADDR) as usize;
 
-/// Where servo parameter blocks are kept, keyed by servo id.
-pub trait ParamStore {
-    /// The block stored for servo `id`, if any.
-    fn load(&mut self, id: u8) -> Result<Option<Block>, StoreError>;
-    /// Stores `block` for servo `id`, replacing an older one.
-    fn save(&mut self, id: u8, block: &Block) -> Result<(), StoreError>;
-}
-
-/// Servo parameter blocks in a range of NOR flash, through [`flash_store::FlashStore`] (wear-levelled,
-/// power-fail safe). The board binds it to the Atom's flash (esp-storage), the virtual robot
-/// and the tests to [`flash_store::MemFlash`].
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct FlashParams<F> {
-    region: FlashRange<F>,
-}
-
-impl<F: NorFlash> FlashParams<F> {
-    /// Blocks kept in `range` of `flash` (whole erase pages, at least two).
-    pub fn new(flash: F, range: Range<u32>) -> Self {
-        Self {
-            region: FlashRange::new(flash, range),
-        }
-    }
-
-    /// The flash, for a look at what is stored (tests, saving the virtual robot's flash).
-    pub fn flash(&self) -> Option<&F> {
-        self.region.flash()
-    }
-}
-
-impl<F: NorFlash> ParamStore for FlashParams<F> {
-    fn load(&mut self, id: u8) -> Result<Option<Block>, StoreError> {
-        self.region.with_store(|store| {
-            let mut block = [0u8; BLOCK_LEN];
-            match store.fetch(id, &mut block)? {
-                Some(BLOCK_LEN) => Ok(Some(block)),
-                Some(_) => Err(StoreError::Corrupted),
-                None => Ok(None),
-            }
-        })
-    }
-
-    fn save(&mut self, id: u8, block: &Block) -> Result<(), StoreError> {
-        self.region.with_store(|store| store.store(id, block))
+/// The block stored for servo `id` in `store`, if any (a record of another length is
+/// corrupt).
+fn load(store: &mut dyn ParamStore, id: u8) -> Result<Option<Block>, StoreError> {
+    let mut block = [0u8; BLOCK_LEN];
+    match store.fetch(id, &mut block)? {
+        Some(BLOCK_LEN) => Ok(Some(block)),
+        Some(_) => Err(StoreError::Corrupted),
+        None => Ok(None),
     }
 }
 
@@ -148,8 +109,8 @@ pub fn take_block(
 ) -> bool {
     let id = cx.settings.config().servo_ids.get(index).copied();
     match (present, store, id) {
-        (Some(block), Some(store), Some(id)) if !restoring => store.save(id, &block).is_ok(),
-        (Some(block), Some(store), Some(id)) => match store.load(id) {
+        (Some(block), Some(store), Some(id)) if !restoring => store.store(id, &block).is_ok(),
+        (Some(block), Some(store), Some(id)) => match load(store, id) {
             Ok(Some(saved)) => restore(cx, motion, index, id, &block, &saved),
             _ => false,
         },
@@ -197,20 +158,7 @@ mod tests {
     use super::*;
     use crate::bank::test_support::{at_rest, queued};
 
-    /// Blocks kept in memory.
-    #[derive(Default)]
-    struct Memory(std::vec::Vec<(u8, Block)>);
-
-    impl ParamStore for Memory {
-        fn load(&mut self, id: u8) -> Result<Option<Block>, StoreError> {
-            Ok(self.0.iter().find(|(i, _)| *i == id).map(|(_, b)| *b))
-        }
-        fn save(&mut self, id: u8, block: &Block) -> Result<(), StoreError> {
-            self.0.retain(|(i, _)| *i != id);
-            self.0.push((id, *block));
-            Ok(())
-        }
-    }
+    use crate::store::test_support::Memory;
 
     /// A block in position mode, every other byte `fill`, the homing offset `homing_offset`.
     fn block(fill: u8, homing_offset: u8) -> Block {
@@ -232,7 +180,7 @@ mod tests {
         let (settings, mut bank) = at_rest();
         let mut store = Memory::default();
         if let Some(saved) = saved {
-            store.save(2, &saved).unwrap();
+            store.store(2, &saved).unwrap();
         }
         let cx = &mut Context::new(0, &mut bank, &settings);
         let mut motion = MotionController::new();
@@ -245,7 +193,7 @@ mod tests {
     fn a_backup_stores_the_block_under_the_servo_id() {
         let (ok, ops, _, mut store) = take_joint_2(false, None, Some(block(7, 0)));
         assert!(ok && ops.is_empty());
-        assert_eq!(store.load(2), Ok(Some(block(7, 0))));
+        assert_eq!(load(&mut store, 2), Ok(Some(block(7, 0))));
         assert!(!take_joint_2(false, None, None).0, "no answer");
     }
 

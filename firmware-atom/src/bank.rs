@@ -255,6 +255,15 @@ impl ServoBank {
         }
     }
 
+    /// When servo `index`'s last state read arrived (monotonic microseconds); `None` before
+    /// the first or for an index without a servo.
+    pub fn read_at_us(&self, index: usize) -> Option<u64> {
+        self.servos
+            .get(index)
+            .filter(|s| s.health.ever_answered)
+            .map(|s| s.read_us)
+    }
+
     /// Time from servo `index`'s last state read to `now_us`, microseconds.
     fn read_age_us(&self, now_us: u64, index: usize) -> u64 {
         now_us.saturating_sub(self.servos.get(index).map_or(0, |s| s.read_us))

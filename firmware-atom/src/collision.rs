@@ -20,11 +20,18 @@ use core::ops::RangeInclusive;
 
 use protocol_core::servo::fault;
 
+use flash_store::StoreError;
+
 use crate::config::JOINTS;
 use crate::health::ServoHealth;
+use crate::store::{COLLISION_SETTINGS_KEY, ParamStore};
 
 /// The thresholds a joint may have (pymycobot's range; smaller triggers more easily).
 pub const THRESHOLDS: RangeInclusive<u8> = 50..=250;
+/// Whether collision protection is on until the host switches it (0x74) or the flash says
+/// otherwise. Chosen from the benchmark `collision` (docs/motion.md): no false alarm over its
+/// corpus at the default threshold.
+pub const DEFAULT_PROTECTION: bool = true;
 /// Every joint's threshold until the host sets one (pymycobot's default).
 pub const DEFAULT_THRESHOLD: u8 = 100;
 /// A shaft turning slower than this (steps/s, 8.8 deg/s) while it presses is held back.
@@ -108,6 +115,19 @@ impl CollisionSettings {
         bytes
     }
 
+    /// The settings kept in `store` ([`COLLISION_SETTINGS_KEY`]); `None` if there are none or
+    /// the record is not a valid one.
+    pub fn load(store: &mut dyn ParamStore) -> Option<Self> {
+        let mut bytes = [0; Self::BYTES];
+        let len = store.fetch(COLLISION_SETTINGS_KEY, &mut bytes).ok()??;
+        Self::from_bytes(bytes.get(..len)?)
+    }
+
+    /// Keeps these settings in `store`, so they survive a restart.
+    pub fn save(&self, store: &mut dyn ParamStore) -> Result<(), StoreError> {
+        store.store(COLLISION_SETTINGS_KEY, &self.to_bytes())
+    }
+
     /// Settings stored by [`CollisionSettings::to_bytes`]; `None` for anything else (a record
     /// of another length or with a value out of range).
     pub fn from_bytes(bytes: &[u8]) -> Option<Self> {
@@ -123,9 +143,10 @@ impl CollisionSettings {
     }
 }
 
-/// What the arm was doing when the collision was felt; it chooses the error code.
+/// What the arm was doing when the collision was felt; it chooses the error code
+/// ([`Kind::code`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Activity {
+pub enum Kind {
     /// Moving in joint space: angles, encoders, jogs, streams (code 16).
     JointMotion,
     /// Moving in Cartesian space: coordinates, lines, arcs, coordinate jogs (code 17).
@@ -140,23 +161,30 @@ pub struct Collision {
     /// The joint that pressed, 0-based.
     pub joint: usize,
     /// What the arm was doing.
-    pub activity: Activity,
+    pub kind: Kind,
     /// When the collision was detected (the confirming state read), monotonic microseconds.
     pub at_us: u64,
     /// The joint's present load then, signed thousandths of its maximum torque.
     pub load_permille: i16,
 }
 
-impl Collision {
+impl Kind {
     /// The error code get error information (0x07) reports: 16 in a joint-space motion, 17 in
     /// a Cartesian motion, 18 when the arm was holding still (19, the last of pymycobot's
     /// collision codes, is not used).
-    pub fn code(&self) -> u8 {
-        match self.activity {
-            Activity::JointMotion => 16,
-            Activity::CartesianMotion => 17,
-            Activity::Holding => 18,
+    pub fn code(self) -> u8 {
+        match self {
+            Kind::JointMotion => 16,
+            Kind::CartesianMotion => 17,
+            Kind::Holding => 18,
         }
+    }
+}
+
+impl Collision {
+    /// The error code get error information (0x07) reports ([`Kind::code`]).
+    pub fn code(&self) -> u8 {
+        self.kind.code()
     }
 }
 
@@ -167,22 +195,30 @@ pub struct CollisionDetector {
     pressing: [u8; JOINTS],
     /// The collision detected and not yet cleared.
     latched: Option<Collision>,
+    /// When the state read of each joint looked at last arrived.
+    seen_us: [Option<u64>; JOINTS],
 }
 
 impl CollisionDetector {
-    /// Looks at a fresh state read of joint `joint` (0-based) at `now_us`; returns the collision
-    /// it confirms, once (it stays latched until [`CollisionDetector::clear`]). Nothing is
-    /// watched while `settings` has detection off, while a collision is latched, or on a servo
-    /// that is not answering, has its torque off, or reports its own overload protection (a
-    /// servo fault, reported as such).
+    /// Looks at joint `joint`'s (0-based) state read that arrived at `read_us`, at `now_us`;
+    /// a read already looked at is skipped. Returns the collision it confirms, once (it stays
+    /// latched until [`CollisionDetector::clear`]). Nothing is watched while `settings` has
+    /// detection off, while a collision is latched, or on a servo that is not answering, has
+    /// its torque off, or reports its own overload protection (a servo fault, reported as such).
     pub fn on_state(
         &mut self,
         now_us: u64,
         joint: usize,
+        read_us: u64,
         state: &ServoHealth,
         settings: &CollisionSettings,
-        activity: Activity,
+        kind: Kind,
     ) -> Option<Collision> {
+        let seen = self.seen_us.get_mut(joint)?;
+        if *seen == Some(read_us) {
+            return None;
+        }
+        *seen = Some(read_us);
         let count = self.pressing.get_mut(joint)?;
         let watched = settings.enabled()
             && self.latched.is_none()
@@ -202,7 +238,7 @@ impl CollisionDetector {
         }
         let collision = Collision {
             joint,
-            activity,
+            kind,
             at_us: now_us,
             load_permille: state.load_permille,
         };
@@ -244,11 +280,11 @@ mod tests {
         let mut detector = CollisionDetector::default();
         let pressing = state(-600, 0);
         assert_eq!(
-            detector.on_state(0, 1, &pressing, &ON, Activity::JointMotion),
+            detector.on_state(0, 1, 0, &pressing, &ON, Kind::JointMotion),
             None
         );
         let collision = detector
-            .on_state(4_400, 1, &pressing, &ON, Activity::JointMotion)
+            .on_state(4_400, 1, 4_400, &pressing, &ON, Kind::JointMotion)
             .unwrap();
         assert_eq!(
             (collision.joint, collision.code(), collision.at_us),
@@ -256,7 +292,7 @@ mod tests {
         );
         assert_eq!(detector.collision(), Some(collision));
         assert_eq!(
-            detector.on_state(8_800, 1, &pressing, &ON, Activity::JointMotion),
+            detector.on_state(8_800, 1, 8_800, &pressing, &ON, Kind::JointMotion),
             None,
             "reported once"
         );
@@ -265,12 +301,27 @@ mod tests {
     }
 
     #[test]
+    fn the_same_read_looked_at_twice_counts_once() {
+        let mut detector = CollisionDetector::default();
+        let pressing = state(700, 0);
+        for now in [0, 1_000, 2_000] {
+            let again = detector.on_state(now, 4, 0, &pressing, &ON, Kind::Holding);
+            assert_eq!(again, None);
+        }
+        assert!(
+            detector
+                .on_state(3_000, 4, 2_900, &pressing, &ON, Kind::Holding)
+                .is_some()
+        );
+    }
+
+    #[test]
     fn a_loaded_joint_that_turns_is_speeding_up_not_colliding() {
         let mut detector = CollisionDetector::default();
         for t in 0..10 {
             let speeding_up = state(580, 900);
             assert_eq!(
-                detector.on_state(t, 0, &speeding_up, &ON, Activity::JointMotion),
+                detector.on_state(t, 0, t, &speeding_up, &ON, Kind::JointMotion),
                 None
             );
         }
@@ -281,10 +332,10 @@ mod tests {
         let mut detector = CollisionDetector::default();
         let driven = state(-1000, 1500);
         assert_eq!(
-            detector.on_state(0, 2, &driven, &ON, Activity::Holding),
+            detector.on_state(0, 2, 0, &driven, &ON, Kind::Holding),
             None
         );
-        let pushed = detector.on_state(1, 2, &driven, &ON, Activity::Holding);
+        let pushed = detector.on_state(1, 2, 1, &driven, &ON, Kind::Holding);
         assert_eq!(pushed.map(|c| c.code()), Some(18));
     }
 
@@ -294,7 +345,7 @@ mod tests {
         for (t, load) in [600, 100, 600, 100, 600].into_iter().enumerate() {
             let read = state(load, 0);
             assert_eq!(
-                detector.on_state(t as u64, 2, &read, &ON, Activity::Holding),
+                detector.on_state(t as u64, 2, t as u64, &read, &ON, Kind::Holding),
                 None
             );
         }
@@ -308,17 +359,17 @@ mod tests {
         let hard = state(900, 0);
         for t in 0..5 {
             assert_eq!(
-                detector.on_state(t, 3, &hard, &settings, Activity::Holding),
+                detector.on_state(t, 3, t, &hard, &settings, Kind::Holding),
                 None
             );
         }
         assert!(
             detector
-                .on_state(5, 0, &hard, &settings, Activity::Holding)
+                .on_state(5, 0, 5, &hard, &settings, Kind::Holding)
                 .is_none()
         );
         let pushed = detector
-            .on_state(6, 0, &hard, &settings, Activity::Holding)
+            .on_state(6, 0, 6, &hard, &settings, Kind::Holding)
             .unwrap();
         assert_eq!(pushed.code(), 18);
         let mut off = CollisionDetector::default();
@@ -327,9 +378,10 @@ mod tests {
                 off.on_state(
                     t,
                     0,
+                    t,
                     &hard,
                     &CollisionSettings::new(false),
-                    Activity::Holding
+                    Kind::Holding
                 ),
                 None
             );
@@ -345,7 +397,7 @@ mod tests {
         };
         for t in 0..5 {
             assert_eq!(
-                detector.on_state(t, 1, &overloaded, &ON, Activity::JointMotion),
+                detector.on_state(t, 1, t, &overloaded, &ON, Kind::JointMotion),
                 None
             );
         }
@@ -372,5 +424,17 @@ mod tests {
             None
         );
         assert_eq!(CollisionSettings::from_bytes(&[1, 100]), None);
+    }
+
+    #[test]
+    fn settings_survive_in_the_store_and_a_bad_record_is_ignored() {
+        let mut store = crate::store::test_support::Memory::default();
+        assert_eq!(CollisionSettings::load(&mut store), None);
+        let mut settings = CollisionSettings::new(true);
+        settings.set_threshold(2, 180).unwrap();
+        settings.save(&mut store).unwrap();
+        assert_eq!(CollisionSettings::load(&mut store), Some(settings));
+        store.store(COLLISION_SETTINGS_KEY, &[7, 7]).unwrap();
+        assert_eq!(CollisionSettings::load(&mut store), None);
     }
 }

@@ -16,6 +16,7 @@ use protocol_core::command::{
 use protocol_core::units::{Centideg, Decideg};
 
 use crate::cartesian::for_client;
+use crate::collision::CollisionSettings;
 use crate::config::{GRIPPER, JOINTS, SERVOS, in_encoder_range};
 use crate::context::Context;
 use crate::error::AtomError;
@@ -24,6 +25,7 @@ use crate::io::{AtomIo, PinMode, is_output_pin, mode_allowed};
 use crate::link::Link;
 use crate::motion::{Command, JogDirection, Target};
 use crate::parts::Parts;
+use crate::settings::Settings;
 use crate::waiting::WaitingRead;
 use crate::{backup, gains, gripper, registers, tolerance};
 
@@ -83,6 +85,21 @@ fn done() -> Answer {
     Answer::Done(Ok(()))
 }
 
+/// Makes `changed` the collision settings, kept in the flash the board lends so they survive
+/// a restart (a board without a store keeps them until it restarts). A flash that fails
+/// refuses the change: nothing changes.
+fn adopt_collision_settings<I: AtomIo>(
+    settings: &mut Settings,
+    changed: CollisionSettings,
+    io: &mut I,
+) -> Result<(), AtomError> {
+    if let Some(store) = io.param_store() {
+        changed.save(store).map_err(|_| AtomError::Invalid)?;
+    }
+    *settings.collision_mut() = changed;
+    Ok(())
+}
+
 fn execute<I: AtomIo>(
     p: &mut Parts,
     now_us: u64,
@@ -91,6 +108,10 @@ fn execute<I: AtomIo>(
     io: &mut I,
 ) -> Answer {
     use Request as R;
+    if matches!(request, R::ClearErrorInfo | R::PowerOn) {
+        // Both end a collision's refusal of motion (docs/protocol.md section 7).
+        p.clear_collision();
+    }
     let Parts {
         settings,
         bank,
@@ -100,6 +121,7 @@ fn execute<I: AtomIo>(
         dispenser,
         errors,
         waiting,
+        collision: _,
     } = p;
     match request {
         // --- status and system ---
@@ -379,7 +401,7 @@ fn execute<I: AtomIo>(
             speeds_steps_per_s,
         } => {
             let cx = &mut Context::new(now_us, bank, settings);
-            Answer::Done(registers::drag_to(cx, encoders, speeds_steps_per_s))
+            Answer::Done(registers::drag_to(cx, motion, encoders, speeds_steps_per_s))
         }
         R::GetSpeed => Answer::Now(Reply::Byte(settings.speed_percent())),
         R::SetSpeed { speed } => {
@@ -474,6 +496,22 @@ fn execute<I: AtomIo>(
                 }),
             )
         }
+
+        // --- collision protection ---
+        R::SetCollisionMode { on } => {
+            let mut changed = *settings.collision();
+            changed.set_enabled(on);
+            Answer::Done(adopt_collision_settings(settings, changed, io))
+        }
+        R::GetCollisionMode => byte(settings.collision().enabled()),
+        R::SetCollisionThreshold { joint, threshold } => {
+            let mut changed = *settings.collision();
+            if changed.set_threshold(joint.get(), threshold.get()).is_err() {
+                return Answer::Done(Err(AtomError::Invalid));
+            }
+            Answer::Done(adopt_collision_settings(settings, changed, io))
+        }
+        R::GetCollisionThresholds => Answer::Now(Reply::Bytes6(settings.collision().thresholds())),
 
         // --- Atom IO, LED, gripper ---
         R::SetPinMode { pin, mode } => {

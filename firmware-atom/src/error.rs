@@ -4,6 +4,8 @@
 use kinematics_core::{IkError, PathError};
 use protocol_core::command::{ErrorCode, JointId};
 
+use crate::collision::Kind;
+
 /// Why a command or a motion was not carried out. A refused command answers `00` and changes
 /// nothing; a motion that fails on the way stops the arm. Either way the error is recorded for
 /// 0x07 where the protocol has a code for it.
@@ -24,11 +26,13 @@ pub enum AtomError {
     Busy,
     /// The command cannot be carried out for another reason (bad register, missing servo).
     Invalid,
+    /// A collision stopped the arm ([`crate::collision`]); motion is refused until cleared.
+    Collision(Kind),
 }
 
 impl AtomError {
     /// The error code 0x07 reports for this failure (`docs/protocol.md` section 7), if it has one:
-    /// 1..=6 joint limit, 32 unreachable pose, 33 / 34 no continuous path (or an arc without a
+    /// 1..=6 joint limit, 16..=18 a collision ([`Kind::code`]), 32 unreachable pose, 33 / 34 no continuous path (or an arc without a
     /// circle, 33).
     pub fn error_code(self) -> Option<ErrorCode> {
         match self {
@@ -38,6 +42,7 @@ impl AtomError {
                 .map(ErrorCode::JointLimit),
             Self::Unreachable => Some(ErrorCode::IkNoSolution),
             Self::Path(e) => ErrorCode::from_code(e.protocol_code()),
+            Self::Collision(kind) => ErrorCode::from_code(kind.code()),
             Self::PoweredOff | Self::GripperRange | Self::Busy | Self::Invalid => None,
         }
     }

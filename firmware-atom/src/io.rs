@@ -55,7 +55,7 @@ pub trait AtomIo {
     /// True while the Atom's button (GPIO39, active low) is held down.
     fn button_pressed(&mut self) -> bool;
     /// The flash store of servo parameter backups (0xEA/0xEB); `None` if the board has none.
-    fn param_store(&mut self) -> Option<&mut dyn crate::backup::ParamStore> {
+    fn param_store(&mut self) -> Option<&mut dyn crate::store::ParamStore> {
         None
     }
 
@@ -69,7 +69,7 @@ pub trait AtomIo {
 }
 
 /// Flash of the parameter backups in [`RecordingIo`]: four 4 KiB pages.
-pub type MemParams = crate::backup::FlashParams<flash_store::MemFlash<{ 4 * 4096 }>>;
+pub type MemParams = crate::store::FlashParams<flash_store::MemFlash<{ 4 * 4096 }>>;
 
 /// What is wired to a user pin outside the Atom, in a simulation ([`RecordingIo::set_wiring`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -217,7 +217,7 @@ impl AtomIo for RecordingIo {
         self.button
     }
 
-    fn param_store(&mut self) -> Option<&mut dyn crate::backup::ParamStore> {
+    fn param_store(&mut self) -> Option<&mut dyn crate::store::ParamStore> {
         Some(&mut self.params)
     }
 

@@ -82,6 +82,7 @@ mod registers;
 pub mod safety;
 mod schedule;
 mod settings;
+pub mod store;
 pub mod tolerance;
 mod waiting;
 

@@ -2,9 +2,12 @@
 //! [`crate::Atom`] runs them. Nothing here knows the host protocol.
 
 use crate::bank::ServoBank;
+use crate::collision::CollisionDetector;
+use crate::config::JOINTS;
+use crate::context::Context;
 use crate::dispenser::Dispenser;
 use crate::drag::DragRecorder;
-use crate::error::ErrorLog;
+use crate::error::{AtomError, ErrorLog};
 use crate::gripper::Gripper;
 use crate::motion::MotionController;
 use crate::settings::Settings;
@@ -29,6 +32,8 @@ pub struct Parts {
     pub errors: ErrorLog,
     /// Requests whose replies wait for servo reads (0x53, 0x2D, 0xEA/0xEB).
     pub waiting: WaitingReads,
+    /// Collision detection.
+    pub collision: CollisionDetector,
 }
 
 impl Parts {
@@ -42,8 +47,39 @@ impl Parts {
             dispenser: Dispenser::default(),
             errors: ErrorLog::default(),
             waiting: WaitingReads::default(),
+            collision: CollisionDetector::default(),
             settings,
         }
+    }
+
+    /// Looks at the joints' fresh state reads for a collision; on one, the arm stops
+    /// ([`MotionController::collided`]) and the error is recorded for 0x07.
+    pub fn watch_collisions(&mut self, now_us: u64) {
+        let kind = self.motion.collision_kind();
+        let mut found = None;
+        for joint in 0..JOINTS {
+            let (Some(state), Some(read_us)) =
+                (self.bank.health(joint), self.bank.read_at_us(joint))
+            else {
+                continue;
+            };
+            let settings = self.settings.collision();
+            found = found.or(self
+                .collision
+                .on_state(now_us, joint, read_us, state, settings, kind));
+        }
+        if let Some(collision) = found {
+            let cx = &mut Context::new(now_us, &mut self.bank, &self.settings);
+            self.motion.collided(cx, &collision);
+            self.errors.record(AtomError::Collision(collision.kind));
+        }
+    }
+
+    /// Forgets a collision (0x08 clear error information, 0x10 power on): motion is allowed
+    /// again.
+    pub fn clear_collision(&mut self) {
+        self.collision.clear();
+        self.motion.unlock();
     }
 
     /// True at `now_us` while the arm moves ([`MotionController::is_moving`]).

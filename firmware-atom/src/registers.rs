@@ -90,6 +90,9 @@ pub fn write(
             };
         }
         ((Access::Goal, Access::Goal), ServoValue::Word(w)) if addr == reg::GOAL_POSITION => {
+            if index < JOINTS {
+                motion.may_move(cx)?;
+            }
             return move_to_steps(cx, index, Steps(sign_magnitude(w, 15)));
         }
         ((Access::Write, Access::Write), _) => {}
@@ -182,14 +185,17 @@ fn id(settings: &Settings, index: usize) -> Result<u8, AtomError> {
 /// Fastest goal speed a drag (0x3E) may ask for, steps per second: the STS3215's top speed.
 pub const MAX_DRAG_SPEED_STEPS_PER_S: i16 = 3_400;
 
-/// Moves the joints to six encoder positions with their own speeds (0x3E set encoders drag).
+/// Moves the joints to six encoder positions with their own speeds (0x3E set encoders drag), if
+/// a motion may start ([`MotionController::may_move`]).
 /// A speed of 0 (the servo would read it as "as fast as you can"), a negative one or one above
 /// [`MAX_DRAG_SPEED_STEPS_PER_S`] is refused: nothing creeps and nothing races.
 pub fn drag_to(
     cx: &mut Context<'_>,
+    motion: &MotionController,
     encoders: [Steps; JOINTS],
     speeds_steps_per_s: [i16; JOINTS],
 ) -> Result<(), AtomError> {
+    motion.may_move(cx)?;
     if speeds_steps_per_s
         .iter()
         .any(|s| !(1..=MAX_DRAG_SPEED_STEPS_PER_S).contains(s))

@@ -1,5 +1,5 @@
-//! What the host has set: joint limits, fresh/free mode, the default speed and the coordinate
-//! frames. The fields are private and every setter keeps what depends on them in step: a new
+//! What the host has set: joint limits, fresh/free mode, the default speed, the coordinate
+//! frames and collision protection. The fields are private and every setter keeps what depends on them in step: a new
 //! limit is checked against the factory range and handed to the kinematics' branch selection,
 //! a new frame is re-applied to the kinematics model. Values the protocol layer has already
 //! range-checked (speed, modes) are taken as they come.
@@ -8,6 +8,7 @@ use protocol_core::command::{EndType, MoveMode, Pose, ReferenceFrame};
 use protocol_core::units::{Centideg, Decideg, Steps};
 
 use crate::cartesian::Cartesian;
+use crate::collision::{CollisionSettings, DEFAULT_PROTECTION};
 use crate::config::{AtomConfig, FACTORY_LIMITS, JOINTS, JointLimit};
 use crate::error::AtomError;
 
@@ -20,11 +21,14 @@ pub struct Settings {
     free_mode: bool,
     speed_percent: u8,
     cart: Cartesian,
+    collision: CollisionSettings,
 }
 
 impl Settings {
     /// The settings at boot: the configured limits, fresh mode on (a new move replaces the
-    /// current one), free mode off, speed 100 %, flange in the base frame.
+    /// current one), free mode off, speed 100 %, flange in the base frame, collision protection
+    /// as [`DEFAULT_PROTECTION`] says with every threshold at its default (until the flash's
+    /// settings are loaded).
     pub fn new(config: AtomConfig) -> Self {
         Self {
             limits: config.joint_limits,
@@ -33,7 +37,18 @@ impl Settings {
             fresh_mode: true,
             free_mode: false,
             speed_percent: 100,
+            collision: CollisionSettings::new(DEFAULT_PROTECTION),
         }
+    }
+
+    /// Collision protection: mode and thresholds (0x74..0x76, 0xFD).
+    pub fn collision(&self) -> &CollisionSettings {
+        &self.collision
+    }
+
+    /// Collision protection, to change (its setters keep its values in range).
+    pub fn collision_mut(&mut self) -> &mut CollisionSettings {
+        &mut self.collision
     }
 
     /// The configuration the Atom runs with.

@@ -10,7 +10,7 @@
 use protocol_core::Frame;
 use protocol_core::command::{Reply, cmd};
 
-use crate::backup::{self, ParamStore};
+use crate::backup;
 use crate::bank::{Finished, OP_QUEUE, ServoBank, Ticket};
 use crate::config::SERVOS;
 use crate::context::Context;
@@ -19,6 +19,7 @@ use crate::error::AtomError;
 use crate::gains::{self, GroupGains};
 use crate::link::Link;
 use crate::motion::MotionController;
+use crate::store::ParamStore;
 
 /// Requests that can wait at once: as many as the bank has servo operations.
 pub const WAITING: usize = OP_QUEUE;

@@ -280,6 +280,18 @@ fn request_of(kind: RequestKind) -> BoxedStrategy<Request> {
         K::RestoreServoParams => select(ServoSelect::All)
             .prop_map(|servo| R::RestoreServoParams { servo })
             .boxed(),
+        // --- collision protection ---
+        K::SetCollisionMode => any::<bool>()
+            .prop_map(|on| R::SetCollisionMode { on })
+            .boxed(),
+        K::GetCollisionMode => Just(R::GetCollisionMode).boxed(),
+        K::SetCollisionThreshold => (joint(), 50u8..=250)
+            .prop_map(|(joint, t)| R::SetCollisionThreshold {
+                joint,
+                threshold: CollisionThreshold::new(t).unwrap(),
+            })
+            .boxed(),
+        K::GetCollisionThresholds => Just(R::GetCollisionThresholds).boxed(),
         // --- Atom IO, LED, gripper ---
         K::SetPinMode => prop_oneof![
             (

@@ -1,6 +1,7 @@
 //! The whole virtual arm under virtual time: the real Basic and Atom firmware libraries, the
 //! shared bus, seven simulated servos, and the USB serial links of both boards.
 
+use firmware_atom::collision::Collision;
 use firmware_atom::{Atom, AtomConfig, RecordingIo};
 use firmware_basic::clients::CLIENT_RX_BYTES;
 use firmware_basic::wifi::WifiStore;
@@ -274,6 +275,8 @@ pub struct VirtualRobot {
     heard: Vec<HeardByte>,
     noise_station: StationId,
     next_poll_ns: u64,
+    /// Every collision the Atom detected, with the virtual time it was first seen (ns).
+    collisions: Vec<(u64, Collision)>,
 }
 
 impl VirtualRobot {
@@ -314,6 +317,7 @@ impl VirtualRobot {
             heard: Vec::new(),
             noise_station,
             next_poll_ns: 0,
+            collisions: Vec::new(),
         }
     }
 
@@ -559,9 +563,26 @@ impl VirtualRobot {
             let atom_us = (now_ns - self.atom_boot_ns) / 1_000;
             self.atom
                 .poll(atom_us, &mut bus, &mut usb, &mut self.atom_io);
+            self.note_collision(now_ns);
         }
         self.bus.start_transmissions(now_ns);
         self.next_poll_ns = now_ns + POLL_PERIOD_NS;
+    }
+
+    /// Logs the Atom's collision the first time it is seen.
+    fn note_collision(&mut self, now_ns: u64) {
+        let Some(collision) = self.atom.collision() else {
+            return;
+        };
+        if self.collisions.last().map(|(_, c)| c) != Some(&collision) {
+            self.collisions.push((now_ns, collision));
+        }
+    }
+
+    /// Every collision the Atom detected so far: when (virtual time, ns) and what
+    /// ([`firmware_atom::collision::Collision`]), oldest first.
+    pub fn collisions(&self) -> &[(u64, Collision)] {
+        &self.collisions
     }
 
     /// Sends `request` to the Basic's USB port and runs until the first complete frame comes

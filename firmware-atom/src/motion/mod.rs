@@ -14,6 +14,9 @@
 //!   moving one bring every joint to rest at the servos' full deceleration, all joints along
 //!   the path they were on ([`brake`]); a replacing move starts from rest.
 //! * **Queue mode** (fresh mode off): up to [`MOTION_QUEUE`] moves wait their turn.
+//! * **Collisions** ([`crate::collision`]): a detected collision brings the arm to rest like a
+//!   stop, with the blocked joint's goal where it stands, and every new motion is refused with
+//!   the collision's code until [`MotionController::unlock`] (0x08, 0x10).
 //! * **Jog watchdog**: a continuous jog stops when no host command has arrived for
 //!   [`crate::TimingBudget::jog_watchdog_us`] (pymycobot has no keep-alive); the Basic's own
 //!   liveness probe does not count.
@@ -29,6 +32,7 @@ use protocol_core::command::{MoveMode, Pose};
 use protocol_core::units::Centideg;
 
 use crate::bank::ServoBank;
+use crate::collision::{Collision, Kind};
 use crate::config::JOINTS;
 use crate::context::Context;
 use crate::error::AtomError;
@@ -234,6 +238,8 @@ pub struct MotionController {
     paused: Option<Target>,
     last_host_cmd_us: u64,
     clock: StreamClock,
+    /// Why new motion is refused until unlocked: a collision.
+    lock: Option<AtomError>,
 }
 
 impl Default for MotionController {
@@ -251,6 +257,7 @@ impl MotionController {
             paused: None,
             last_host_cmd_us: 0,
             clock: StreamClock::default(),
+            lock: None,
         }
     }
 
@@ -259,10 +266,17 @@ impl MotionController {
         self.last_host_cmd_us = now_us;
     }
 
-    /// Accepts a new motion: refused while the arm is powered off (the one power check of
-    /// every motion), then each kind of motion checks its own rules.
-    pub fn command(&mut self, cx: &mut Context<'_>, command: Command) -> Result<(), AtomError> {
+    /// Whether a new motion may start: the one check every motion passes first. Refused while
+    /// the arm is powered off, or after a collision until [`MotionController::unlock`].
+    pub fn may_move(&self, cx: &Context<'_>) -> Result<(), AtomError> {
         cx.require_power()?;
+        self.lock.map_or(Ok(()), Err)
+    }
+
+    /// Accepts a new motion: refused unless [`MotionController::may_move`], then each kind of
+    /// motion checks its own rules.
+    pub fn command(&mut self, cx: &mut Context<'_>, command: Command) -> Result<(), AtomError> {
+        self.may_move(cx)?;
         match command {
             Command::Move(target) => self.submit(cx, target),
             Command::ToPose {
@@ -448,6 +462,32 @@ impl MotionController {
     pub fn halt(&mut self, cx: &mut Context<'_>) {
         self.clock.reset();
         self.brake(cx, None);
+    }
+
+    /// Reacts to `collision`: every joint brakes as for a stop, the blocked joint's goal is set
+    /// where it stands (its servo stops pressing), and new motion is refused with the
+    /// collision's code until [`MotionController::unlock`].
+    pub fn collided(&mut self, cx: &mut Context<'_>, collision: &Collision) {
+        self.stop(cx);
+        cx.hold_where_it_stands(collision.joint);
+        self.lock = Some(AtomError::Collision(collision.kind));
+    }
+
+    /// Allows motion again after a collision (0x08 clear error information, 0x10 power on).
+    pub fn unlock(&mut self) {
+        self.lock = None;
+    }
+
+    /// What a collision felt now would interrupt: a joint-space motion, a Cartesian one, or
+    /// the arm holding still.
+    pub fn collision_kind(&self) -> Kind {
+        match self.activity {
+            Activity::Idle => Kind::Holding,
+            Activity::Path { .. } => Kind::CartesianMotion,
+            Activity::Joint { .. } | Activity::Stream { .. } | Activity::Braking { .. } => {
+                Kind::JointMotion
+            }
+        }
     }
 
     /// Forgets every motion without sending anything (the servos are about to be released).

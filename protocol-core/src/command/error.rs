@@ -45,6 +45,8 @@ pub enum CommandError {
     BadDragSpeed(i16),
     /// A write to a servo register below 5 (firmware version, model: read-only).
     BadAddress(u8),
+    /// A collision threshold (0x75) outside 50..=250.
+    BadThreshold(u8),
 }
 
 impl core::fmt::Display for CommandError {
@@ -69,6 +71,7 @@ impl core::fmt::Display for CommandError {
             Self::BadGripperSetting(v) => write!(f, "gripper setting {v} is out of range"),
             Self::BadDragSpeed(v) => write!(f, "drag speed {v} is not 0..6000"),
             Self::BadAddress(v) => write!(f, "servo register {v} may not be accessed"),
+            Self::BadThreshold(v) => write!(f, "collision threshold {v} is not 50..250"),
         }
     }
 }

@@ -14,10 +14,10 @@ use super::cmd;
 use super::error::CommandError;
 use super::reply::ReplyKind;
 use super::types::{
-    AtomPin, Axis, AxisValue, BasicInputPin, BasicOutputPin, DataWidth, Direction, EndType,
-    GripperModel, GripperSpeed, GripperState, GripperType, GripperValue, JointId, MoveMode,
-    PinMode, Pose, PositionTarget, ReferenceFrame, Rgb, RpyAxis, ServoId, ServoSelect, ServoValue,
-    TransponderMode,
+    AtomPin, Axis, AxisValue, BasicInputPin, BasicOutputPin, CollisionThreshold, DataWidth,
+    Direction, EndType, GripperModel, GripperSpeed, GripperState, GripperType, GripperValue,
+    JointId, MoveMode, PinMode, Pose, PositionTarget, ReferenceFrame, Rgb, RpyAxis, ServoId,
+    ServoSelect, ServoValue, TransponderMode,
 };
 use super::wire::Writer;
 
@@ -563,6 +563,32 @@ requests! {
         data 1 => |f| Self::RestoreServoParams { servo: f.servo_or_all(254)? },
         emit |w| { w.u8(select_byte(*servo, 254)); };
 
+        // --- collision protection ---
+
+        /// 0x74 set collision mode (protection on or off).
+        SetCollisionMode {
+            /// Collision protection on.
+            on: bool,
+        } = cmd::SET_COLLISION_MODE, reply ReplyKind::Ack,
+        data 1 => |f| Self::SetCollisionMode { on: f.flag()? },
+        emit |w| { w.u8(u8::from(*on)); };
+        /// 0xFD get collision mode.
+        GetCollisionMode = cmd::GET_COLLISION_MODE, reply ReplyKind::Byte;
+        /// 0x75 set one joint's collision threshold.
+        SetCollisionThreshold {
+            /// Joint.
+            joint: JointId,
+            /// Threshold, 50..=250 (smaller triggers more easily).
+            threshold: CollisionThreshold,
+        } = cmd::SET_COLLISION_THRESHOLD, reply ReplyKind::Ack,
+        data 2 => |f| Self::SetCollisionThreshold {
+            joint: f.joint()?,
+            threshold: f.collision_threshold()?,
+        },
+        emit |w| { w.u8(joint.get()).u8(threshold.get()); };
+        /// 0x76 get the six joints' collision thresholds.
+        GetCollisionThresholds = cmd::GET_COLLISION_THRESHOLDS, reply ReplyKind::Bytes6;
+
         // --- Atom IO, LED, gripper ---
 
         /// 0x60 set an Atom pin's mode.
@@ -930,6 +956,28 @@ mod tests {
     }
 
     #[test]
+    fn collision_settings_have_the_layouts_of_pymycobots_closed_loop_arms() {
+        let on = Request::SetCollisionMode { on: true }.to_frame();
+        assert_eq!(
+            on.to_bytes().as_slice(),
+            &[0xFE, 0xFE, 0x03, 0x74, 0x01, 0xFA]
+        );
+        let mode = Request::GetCollisionMode.to_frame();
+        assert_eq!(mode.to_bytes().as_slice(), &[0xFE, 0xFE, 0x02, 0xFD, 0xFA]);
+        let threshold = Request::SetCollisionThreshold {
+            joint: JointId::new(3).unwrap(),
+            threshold: CollisionThreshold::new(250).unwrap(),
+        };
+        let wire = [0xFE, 0xFE, 0x04, 0x75, 0x03, 0xFA, 0xFA];
+        assert_eq!(threshold.to_frame().to_bytes().as_slice(), &wire);
+        assert_eq!(
+            Request::GetCollisionThresholds.reply_kind(),
+            ReplyKind::Bytes6
+        );
+        assert_eq!(Request::GetCollisionMode.reply_kind(), ReplyKind::Byte);
+    }
+
+    #[test]
     fn impossible_values_are_errors_not_commands() {
         use CommandError as E;
         let cases: &[(u8, &[u8], CommandError)] = &[
@@ -950,6 +998,15 @@ mod tests {
             (cmd::SET_BASIC_OUTPUT, &[35, 1], E::BadPin(35)),
             (cmd::GET_BASIC_INPUT, &[2], E::BadPin(2)),
             (cmd::SET_FREE_MODE, &[2], E::BadFlag(2)),
+            (cmd::SET_COLLISION_MODE, &[2], E::BadFlag(2)),
+            (cmd::SET_COLLISION_THRESHOLD, &[0, 100], E::BadJoint(0)),
+            (cmd::SET_COLLISION_THRESHOLD, &[7, 100], E::BadJoint(7)),
+            (cmd::SET_COLLISION_THRESHOLD, &[1, 49], E::BadThreshold(49)),
+            (
+                cmd::SET_COLLISION_THRESHOLD,
+                &[1, 251],
+                E::BadThreshold(251),
+            ),
             (cmd::SEND_COORDS, &[0; 14], E::BadSpeed(0)),
             (cmd::SET_GRIPPER_VALUE, &[101, 50], E::BadGripperValue(101)),
             (cmd::SET_GRIPPER_VALUE, &[50, 101], E::BadSpeed(101)),

@@ -44,6 +44,13 @@ impl JointId {
 }
 
 checked_byte!(
+    /// A joint's collision threshold, 50..=250 (0x75; pymycobot's range, default 100): the
+    /// smaller, the more easily a collision is detected.
+    CollisionThreshold(50..=250),
+    "collision threshold"
+);
+
+checked_byte!(
     /// A servo on the bus, 1..=7: the six joints and the gripper servo (7); also its bus id.
     ServoId(1..=7),
     "servo"

@@ -11,8 +11,8 @@ use esp_hal::{
     time::Rate,
 };
 use esp_storage::FlashStorage;
-use firmware_atom::backup::{FlashParams, ParamStore};
 use firmware_atom::io::{AtomIo, OUTPUT_PINS, PinMode};
+use firmware_atom::store::{FlashParams, ParamStore};
 
 use crate::{
     leds::Leds,

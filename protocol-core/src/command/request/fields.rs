@@ -8,8 +8,9 @@ use crate::units::{Centideg, SpeedPercent, Steps};
 
 use super::super::error::CommandError;
 use super::super::types::{
-    AtomPin, Axis, AxisValue, BasicInputPin, BasicOutputPin, Direction, GripperModel, GripperSpeed,
-    GripperState, GripperType, GripperValue, JointId, Pose, RpyAxis, ServoId, ServoSelect,
+    AtomPin, Axis, AxisValue, BasicInputPin, BasicOutputPin, CollisionThreshold, Direction,
+    GripperModel, GripperSpeed, GripperState, GripperType, GripperValue, JointId, Pose, RpyAxis,
+    ServoId, ServoSelect,
 };
 use super::super::wire::Reader;
 use super::{MAX_DRAG_SPEED, MAX_ENCODER, MIN_SERVO_ADDRESS};
@@ -96,6 +97,10 @@ impl<'a> Fields<'a> {
 
     pub(super) fn joint(&mut self) -> Result<JointId, CommandError> {
         self.checked(JointId::new, CommandError::BadJoint)
+    }
+
+    pub(super) fn collision_threshold(&mut self) -> Result<CollisionThreshold, CommandError> {
+        self.checked(CollisionThreshold::new, CommandError::BadThreshold)
     }
 
     pub(super) fn servo(&mut self) -> Result<ServoId, CommandError> {
