@@ -8,6 +8,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 use clap::Parser;
+use firmware_atom::collision::{Collision, Kind};
 use firmware_basic::wifi::WifiConfig;
 use open_mycobot::host::cli::{Cli, default_basic_flash};
 use open_mycobot::host::emulated::{CONNECT_TIMEOUT, Chardev, EmulatedBoards};
@@ -114,11 +115,18 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
             Err(e) => eprintln!("open-mycobot: the Basic's new server port cannot be had: {e}"),
         });
     }
-    if view.is_some() {
-        driver = driver.observe_every(web::PUBLISH_PERIOD, move |served: &ServedRobot, late| {
+    let publish = view.is_some();
+    let mut collisions_printed = 0;
+    driver = driver.observe_every(web::PUBLISH_PERIOD, move |served: &ServedRobot, late| {
+        let collisions = served.robot.collisions();
+        for (at_ns, collision) in collisions.iter().skip(collisions_printed) {
+            println!("{}", collision_line(*at_ns, collision));
+        }
+        collisions_printed = collisions.len();
+        if publish {
             board.publish(Snapshot::of(&served.robot).ran_late(*late));
-        });
-    }
+        }
+    });
     driver.run(&stop)?;
     drop(view);
     drop(link);
@@ -187,6 +195,23 @@ fn serve_emulated(
     drop(link);
     let _ = writeln!(std::io::stdout(), "stopped");
     Ok(())
+}
+
+/// What the virtual robot prints when the Atom detects a collision.
+fn collision_line(at_ns: u64, collision: &Collision) -> String {
+    let during = match collision.kind {
+        Kind::JointMotion => "moving joints",
+        Kind::CartesianMotion => "moving in a line or arc",
+        Kind::Holding => "holding still",
+    };
+    format!(
+        "collision: joint {} while {during}, error {} (load {:.1} %), at {:.3} s; \
+         clear_error_information() to move again",
+        collision.joint + 1,
+        collision.code(),
+        f64::from(collision.load_permille) / 10.0,
+        at_ns as f64 / 1e9
+    )
 }
 
 /// The `--pty-link` symlink to the pseudo-terminal, if asked for.

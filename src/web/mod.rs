@@ -22,7 +22,7 @@ use std::time::Duration;
 
 pub use board::StateBoard;
 pub use server::WebServer;
-pub use snapshot::Snapshot;
+pub use snapshot::{CollisionMark, Snapshot};
 
 /// Where the view is served unless `--web` says otherwise.
 pub const DEFAULT_ADDR: SocketAddr =

@@ -37,9 +37,22 @@ pub struct Snapshot {
     pub powered: bool,
     /// Whether the Atom is running a motion.
     pub moving: bool,
+    /// The collision the Atom detected and the host has not cleared yet.
+    pub collision: Option<CollisionMark>,
     /// How late the simulation has run behind the wall clock because the machine could not
     /// keep up (zero in virtual-time runs).
     pub late: Lateness,
+}
+
+/// A collision as the view marks it: which joint, what error, when.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CollisionMark {
+    /// The joint that pressed, 1..=6.
+    pub joint: u8,
+    /// The error code 0x07 reports (16..=18).
+    pub code: u8,
+    /// When it was detected, virtual time in microseconds.
+    pub time_us: u64,
 }
 
 impl Snapshot {
@@ -66,6 +79,14 @@ impl Snapshot {
             led_rgb: robot.atom_io().rgb,
             powered: atom.is_powered(),
             moving: atom.is_moving(),
+            collision: atom.collision().and_then(|latched| {
+                let &(at_ns, logged) = robot.collisions().last()?;
+                (logged == latched).then(|| CollisionMark {
+                    joint: u8::try_from(latched.joint + 1).unwrap_or(u8::MAX),
+                    code: latched.code(),
+                    time_us: at_ns / 1_000,
+                })
+            }),
             late: Lateness::default(),
         }
     }
@@ -81,8 +102,10 @@ impl Snapshot {
     /// {"t_s":1.5,"angles_deg":[10,20,-30,15,-25,40],
     ///  "coords":[x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg],"end":"flange","frame":"base",
     ///  "tool":null,"gripper":50,"led":[255,0,0],"powered":true,"moving":false,
-    ///  "late_ms":0,"late_stalls":0}
+    ///  "collision":{"joint":2,"code":16,"t_s":3.25},"late_ms":0,"late_stalls":0}
     /// ```
+    ///
+    /// `collision`: the collision not cleared yet ([`CollisionMark`]), or `null`.
     ///
     /// `late_ms` and `late_stalls`: how much wall time the simulation could not run, and in
     /// how many stalls ([`Lateness`]).
@@ -109,11 +132,24 @@ impl Snapshot {
         let (r, g, b) = self.led_rgb;
         let _ = write!(
             out,
-            ",\"gripper\":{},\"led\":[{r},{g},{b}],\"powered\":{},\"moving\":{},\
-             \"late_ms\":{},\"late_stalls\":{}}}",
-            self.gripper_percent,
-            self.powered,
-            self.moving,
+            ",\"gripper\":{},\"led\":[{r},{g},{b}],\"powered\":{},\"moving\":{},\"collision\":",
+            self.gripper_percent, self.powered, self.moving,
+        );
+        match &self.collision {
+            Some(c) => {
+                let _ = write!(
+                    out,
+                    "{{\"joint\":{},\"code\":{},\"t_s\":{}}}",
+                    c.joint,
+                    c.code,
+                    c.time_us as f64 / 1e6
+                );
+            }
+            None => out.push_str("null"),
+        }
+        let _ = write!(
+            out,
+            ",\"late_ms\":{},\"late_stalls\":{}}}",
             self.late.total_us as f64 / 1e3,
             self.late.stalls
         );
@@ -231,6 +267,11 @@ mod tests {
             led_rgb: (255, 0, 16),
             powered: true,
             moving: false,
+            collision: Some(CollisionMark {
+                joint: 2,
+                code: 16,
+                time_us: 3_250_000,
+            }),
             late: Lateness {
                 total_us: 1_250,
                 stalls: 2,
@@ -250,6 +291,7 @@ mod tests {
                 "led": [255.0, 0.0, 16.0],
                 "powered": true,
                 "moving": false,
+                "collision": {"joint": 2.0, "code": 16.0, "t_s": 3.25},
                 "late_ms": 1.25,
                 "late_stalls": 2.0,
             }))
@@ -269,6 +311,7 @@ mod tests {
             led_rgb: (0, 0, 0),
             powered: false,
             moving: true,
+            collision: None,
             late: Lateness {
                 total_us: u64::MAX,
                 stalls: u32::MAX,
@@ -280,6 +323,23 @@ mod tests {
         assert_eq!(value["coords"][0], json!(3276.7));
         assert_eq!(value["tool"], Value::Null);
         assert_eq!(value["end"], json!("flange"));
+        assert_eq!(value["collision"], Value::Null);
+    }
+
+    #[test]
+    fn a_collision_is_marked_until_the_host_clears_it() {
+        let mut robot = VirtualRobot::new(RobotConfig::default());
+        robot.run_for(1_500_000);
+        assert_eq!(Snapshot::of(&robot).collision, None);
+        robot.push_joint(3, 900);
+        robot.run_for(100_000);
+        let mark = Snapshot::of(&robot).collision.expect("marked");
+        assert_eq!((mark.joint, mark.code), (3, 18));
+        assert!((1_500_000..1_600_000).contains(&mark.time_us), "{mark:?}");
+        robot.push_joint(3, 0);
+        let clear = protocol_core::command::Request::ClearErrorInfo;
+        assert!(robot.ask(&clear).is_ok());
+        assert_eq!(Snapshot::of(&robot).collision, None);
     }
 
     #[test]

@@ -16,6 +16,8 @@ export const LINK_COLOUR = 0xf28c28;
 // the links is orange.
 export const AXIS_COLOURS = [0xff3b3b, 0x3bd23b, 0x3b8bff];
 const JOINT_COLOUR = 0x454b54;
+// A joint the Atom detected a collision on.
+const HIT_COLOUR = 0xd32f2f;
 const BASE_COLOUR = 0x5d6670;
 const GRIPPER_COLOUR = 0xb8c0c8;
 
@@ -32,11 +34,12 @@ function rod(parent, from, to, radius, mat) {
   const a = new THREE.Vector3(...from);
   const b = new THREE.Vector3(...to);
   const length = a.distanceTo(b);
-  if (length < 1e-6) return;
+  if (length < 1e-6) return null;
   const mesh = new THREE.Mesh(new THREE.CylinderGeometry(radius, radius, length, 32), mat);
   mesh.position.copy(a).add(b).multiplyScalar(0.5);
   mesh.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), b.clone().sub(a).normalize());
   parent.add(mesh);
+  return mesh;
 }
 
 // A box of `size` [x, y, z] centred at `at` in `parent`.
@@ -62,8 +65,11 @@ export class Arm {
     this.model = model;
     this.root = new THREE.Group();
     this.frames = [];
+    this.drums = [];
     const links = material(LINK_COLOUR);
     const joints = material(JOINT_COLOUR);
+    this.jointMaterial = joints;
+    this.hitMaterial = material(HIT_COLOUR);
 
     box(this.root, [130, 130, 24], [0, 0, -12], material(BASE_COLOUR));
     let parent = this.root;
@@ -72,7 +78,7 @@ export class Arm {
       const a = model.a_mm[i];
       // Joint i+1 turns about z_i: its drum sits on that axis (joint 1's on the base plate).
       const drumAt = i === 0 ? DRUM_LENGTH_MM / 2 : 0;
-      rod(parent, [0, 0, drumAt - DRUM_LENGTH_MM / 2], [0, 0, drumAt + DRUM_LENGTH_MM / 2], DRUM_RADIUS_MM, joints);
+      this.drums.push(rod(parent, [0, 0, drumAt - DRUM_LENGTH_MM / 2], [0, 0, drumAt + DRUM_LENGTH_MM / 2], DRUM_RADIUS_MM, joints));
       rod(parent, [0, 0, 0], [0, 0, d], LINK_RADIUS_MM, links);
       const frame = new THREE.Group();
       frame.matrixAutoUpdate = false;
@@ -110,7 +116,8 @@ export class Arm {
     this.pose({ angles_deg: [0, 0, 0, 0, 0, 0], gripper: 0, led: [0, 0, 0], tool: null, end: 'flange' });
   }
 
-  // Poses the arm as a state message says (angles, gripper opening, LED colour, tool frame).
+  // Poses the arm as a state message says (angles, gripper opening, LED colour, tool frame,
+  // the joint of a collision).
   pose(state) {
     const m = this.model;
     state.angles_deg.forEach((q, i) => {
@@ -123,6 +130,10 @@ export class Arm {
     const [r, g, b] = state.led;
     this.led.emissive.setRGB(r / 255, g / 255, b / 255, THREE.SRGBColorSpace);
     this.showTool(state.tool, state.end === 'tool');
+    // The drum of a joint the Atom detected a collision on turns red until it is cleared.
+    this.drums.forEach((drum, j) => {
+      drum.material = state.collision?.joint === j + 1 ? this.hitMaterial : this.jointMaterial;
+    });
     this.root.updateMatrixWorld(true);
   }
 

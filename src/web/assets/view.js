@@ -35,6 +35,22 @@ function showReadout(state) {
     status.push(`ran ${state.late_ms.toFixed(0)} ms late (${state.late_stalls} stalls)`);
   }
   $('status').textContent = status.join(' \u00b7 ');
+  showCollision(state.collision);
+}
+
+// What the Atom's error codes 16..18 mean (docs/protocol.md section 7).
+const COLLISION_DURING = { 16: 'moving joints', 17: 'moving in a line or arc', 18: 'holding still' };
+
+// The collision the Atom detected and the host has not cleared: its joint's row marked, and a
+// line saying which joint, what error and when.
+function showCollision(collision) {
+  jointCells.forEach((cell, j) => cell.parentElement.classList.toggle('hit', collision?.joint === j + 1));
+  $('collision').hidden = !collision;
+  if (collision) {
+    const during = COLLISION_DURING[collision.code] ?? 'collision';
+    $('collision').textContent =
+      `collision: J${collision.joint} (error ${collision.code}, ${during}) at ${collision.t_s.toFixed(2)} s; clear_error_information() to move again`;
+  }
 }
 
 function showLink(up) {
@@ -108,7 +124,7 @@ let scheduled = false;
 // Everything in a state message that is read out or drawn, except the time: an arm at rest
 // sends the same key 60 times a second, and then the page does nothing.
 const keyOf = (s) =>
-  JSON.stringify([s.angles_deg, s.coords, s.end, s.frame, s.tool, s.gripper, s.led, s.powered, s.moving, s.late_stalls]);
+  JSON.stringify([s.angles_deg, s.coords, s.end, s.frame, s.tool, s.gripper, s.led, s.powered, s.moving, s.collision, s.late_stalls]);
 
 function schedule() {
   if (!scheduled) {
