@@ -505,6 +505,12 @@ impl SimServo {
         self.push_permille = f64::from(permille.clamp(-3000, 3000));
     }
 
+    /// Where the position loop wants the shaft (the motion profile's position), in steps as
+    /// the registers count them: for measuring how far a servo presses past what stopped it.
+    pub fn setpoint_steps(&self) -> f64 {
+        self.setpoint_steps - f64::from(self.homing_offset())
+    }
+
     /// True while a stop holds the shaft away from where its position loop wants it.
     pub fn blocked(&self) -> bool {
         self.stops.iter().any(|stop| {
