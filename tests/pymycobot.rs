@@ -30,7 +30,8 @@ struct Robot {
 }
 
 impl Robot {
-    fn start() -> Robot {
+    /// The robot, with `extra` arguments on its command line.
+    fn start(extra: &[&str]) -> Robot {
         let link = std::env::temp_dir().join(format!("open-mycobot-e2e-{}", std::process::id()));
         let link_arg = link.to_str().expect("temp dir path is UTF-8");
         // The Basic's flash (Wi-Fi settings the suite changes) in a scratch file, erased.
@@ -38,7 +39,7 @@ impl Robot {
         let _ = fs::remove_file(&flash);
         let flash_arg = flash.to_str().expect("target dir path is UTF-8");
         // The view on too (nobody watches it): the suite runs with the simulation publishing.
-        let launched = launch(&[
+        let mut args = vec![
             "--pty-link",
             link_arg,
             "--tcp",
@@ -47,7 +48,9 @@ impl Robot {
             "127.0.0.1:0",
             "--basic-flash",
             flash_arg,
-        ]);
+        ];
+        args.extend_from_slice(extra);
+        let launched = launch(&args);
         let tcp = launched
             .banner_value("tcp on ")
             .unwrap_or_else(|| panic!("no TCP address in the banner:\n{}", launched.banner))
@@ -60,14 +63,16 @@ impl Robot {
     }
 }
 
-/// Runs `python -m unittest` on tests/e2e with a deadline; returns (success, output).
-fn run_suite(python: &Path, robot: &Robot) -> (bool, String) {
+/// Runs `python -m unittest` on the modules of tests/e2e named like `pattern` (e.g.
+/// `test_*.py`) with a deadline; returns (success, output).
+fn run_suite(python: &Path, robot: &Robot, pattern: &str) -> (bool, String) {
     let e2e = workspace().join("tests/e2e");
     let mut child = Command::new(python)
         .args(["-m", "unittest", "discover", "-v", "-s"])
         .arg(&e2e)
         .arg("-t")
         .arg(&e2e)
+        .args(["-p", pattern])
         .env("MYCOBOT_PORT", &robot.link)
         .env("MYCOBOT_TCP", &robot.tcp)
         // Started just now: its start-up state is checked, not only reset.
@@ -119,14 +124,14 @@ fn run_suite(python: &Path, robot: &Robot) -> (bool, String) {
 #[test]
 fn pymycobot_end_to_end_suite() {
     let python = python();
-    let mut robot = Robot::start();
+    let mut robot = Robot::start(&[]);
     assert!(
         fs::read_link(&robot.link).is_ok(),
         "--pty-link did not create {}",
         robot.link.display()
     );
 
-    let (passed, output) = run_suite(&python, &robot);
+    let (passed, output) = run_suite(&python, &robot, "test_*.py");
 
     let exit = robot.launched.stop_with(Signal::SIGTERM);
     let link_left = fs::symlink_metadata(&robot.link).is_ok();
@@ -137,6 +142,30 @@ fn pymycobot_end_to_end_suite() {
         "the robot did not stop cleanly on SIGTERM: {exit:?}"
     );
     assert!(!link_left, "the pty symlink was not removed on exit");
+}
+
+/// Collision protection with pymycobot against a robot with an obstacle in joint 2's way at
+/// 30 degrees (tests/e2e/obstacle_suite.py); the robot announces the obstacle and prints the
+/// collisions it detects.
+#[test]
+fn pymycobot_against_an_obstacle() {
+    let python = python();
+    let mut robot = Robot::start(&["--obstacle", "2:30"]);
+    assert_eq!(
+        robot.launched.banner_value("obstacle: "),
+        Some("joint 2 at 30.00 deg")
+    );
+    let (passed, output) = run_suite(&python, &robot, "obstacle_*.py");
+    robot.launched.stop_with(Signal::SIGTERM);
+    let printed = robot.launched.printed_after_ready();
+    assert!(passed, "obstacle suite failed:\n{output}");
+    println!("{output}");
+    assert!(
+        printed
+            .iter()
+            .any(|line| line.starts_with("collision: joint 2 while moving joints, error 16")),
+        "the robot printed no collision: {printed:?}"
+    );
 }
 
 #[test]

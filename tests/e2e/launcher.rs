@@ -19,6 +19,8 @@ const STOP_DEADLINE: Duration = Duration::from_secs(5);
 pub struct Launched {
     pub child: Child,
     pub banner: String,
+    /// The lines it printed after the banner, as they come.
+    lines: mpsc::Receiver<String>,
 }
 
 impl Launched {
@@ -27,6 +29,15 @@ impl Launched {
         self.banner
             .lines()
             .find_map(|line| line.strip_prefix(prefix))
+    }
+
+    /// The lines the robot printed after "ready" so far (collisions, port moves).
+    #[allow(
+        dead_code,
+        reason = "only some of the test crates that include this file read them"
+    )]
+    pub fn printed_after_ready(&self) -> Vec<String> {
+        self.lines.try_iter().collect()
     }
 
     /// Sends `signal` and waits for the exit; kills the robot and returns None if it hangs.
@@ -55,7 +66,8 @@ impl Drop for Launched {
 }
 
 /// Starts the robot binary with `args` and waits for its "ready" line. Its stdout keeps being
-/// drained afterwards, so the robot never blocks on (or fails writing to) a full pipe.
+/// drained afterwards, so the robot never blocks on (or fails writing to) a full pipe; the
+/// lines are kept for [`Launched::printed_after_ready`].
 pub fn launch(args: &[&str]) -> Launched {
     let mut child = Command::new(env!("CARGO_BIN_EXE_open-mycobot"))
         .args(args)
@@ -79,7 +91,11 @@ pub fn launch(args: &[&str]) -> Launched {
                 banner.push_str(&line);
                 banner.push('\n');
                 if line.starts_with("ready") {
-                    return Launched { child, banner };
+                    return Launched {
+                        child,
+                        banner,
+                        lines,
+                    };
                 }
             }
             Err(e) => {

@@ -72,7 +72,7 @@ def looks_fresh(contact):
 def reset(mc):
     """Puts the robot into the state the tests start from, whatever was done to it before:
     framed transponder mode, powered on with every servo holding, no error, free mode off,
-    fresh mode on, default speed 100 %, factory joint limits, flange in the base frame with no
+    fresh mode on, collision protection on (the default), default speed 100 %, factory joint limits, flange in the base frame with no
     tool or world offset, joint-interpolated moves, and all joints at 0. What it cannot undo:
     a servo whose zero was moved (set_servo_calibration) stays so; restart the robot."""
     zero = [0.0] * 6
@@ -83,6 +83,7 @@ def reset(mc):
         ("clear_error_information", mc.clear_error_information()),
         ("set_free_mode(0)", mc.set_free_mode(0)),
         ("set_fresh_mode(1)", mc.set_fresh_mode(1)),
+        ("set collision mode 1 (0x74)", _raw_ack(mc, frame(0x74, 1))),
         ("set speed 100 (0x41)", _raw_ack(mc, frame(0x41, 100))),
         ("set_end_type(0)", mc.set_end_type(0)),
         ("set_reference_frame(0)", mc.set_reference_frame(0)),
