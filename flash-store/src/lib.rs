@@ -1,5 +1,5 @@
 //! A small key-value store in NOR flash, for settings that must survive a power cycle: today
-//! the Atom's servo parameter backups and collision settings (the Basic does not use it).
+//! the Atom's servo parameter backups and collision settings, and the Basic's Wi-Fi settings.
 //!
 //! The store is `sequential-storage`'s map: items are appended and old ones erased a page at a
 //! time, so the flash wears evenly, and an interrupted write leaves the previous value readable.
