@@ -351,7 +351,8 @@ fn recorded_calls_mean_what_the_user_asked() {
 fn recorded_file_covers_every_command_pymycobot_uses() {
     let codes: std::collections::BTreeSet<u8> = recorded().iter().map(|(b, _)| b[3]).collect();
     // Every modelled command except the ones MyCobot280 4.0.7 has no method for (the older
-    // speed commands, and MyCobotBasic's PID and arc commands).
+    // speed commands, MyCobotBasic's PID and arc commands, and the collision settings of
+    // pymycobot's closed-loop arms).
     let not_in_mycobot280 = [
         cmd::GET_SPEED,
         cmd::SET_SPEED,
@@ -360,6 +361,10 @@ fn recorded_file_covers_every_command_pymycobot_uses() {
         cmd::GET_PID,
         cmd::MOVE_C_COORDS,
         cmd::MOVE_C_COORDS_FROM_HERE,
+        cmd::SET_COLLISION_MODE,
+        cmd::GET_COLLISION_MODE,
+        cmd::SET_COLLISION_THRESHOLD,
+        cmd::GET_COLLISION_THRESHOLDS,
     ];
     for code in cmd::ALL {
         if not_in_mycobot280.contains(&code) {
