@@ -121,13 +121,12 @@ impl WaitingReads {
         let reply = match &mut waiter.read {
             WaitingRead::ServoData { two_bytes: true } => {
                 let value = answer.and_then(|p| p.u16_at(0)).map_or(-1, |v| v as i16);
-                Frame::new(cmd::GET_SERVO_DATA, &value.to_be_bytes())
+                Some(Reply::Int16(value).to_frame(cmd::GET_SERVO_DATA))
             }
             WaitingRead::ServoData { two_bytes: false } => {
-                let value = answer
-                    .and_then(|p| p.params().first())
-                    .map_or(-1, |&v| i16::from(v));
-                Frame::new(cmd::GET_SERVO_DATA, &[value as u8])
+                // A servo that does not answer reads FF, as 0xE4 reports one.
+                let value = answer.and_then(|p| p.params().first()).map_or(0xFF, |&v| v);
+                Some(Reply::Byte(value).to_frame(cmd::GET_SERVO_DATA))
             }
             WaitingRead::Pid { ids, got } => {
                 let group = ids.iter().position(|&id| id == done.id)?;
@@ -161,7 +160,7 @@ impl WaitingReads {
                 } else {
                     cmd::BACKUP_SERVO_PARAMS
                 };
-                Frame::new(code, &[u8::from(*ok)])
+                Some(Reply::Byte(u8::from(*ok)).to_frame(code))
             }
         };
         let link = waiter.link;
