@@ -123,6 +123,20 @@ impl CollisionSettings {
         Self::from_bytes(bytes.get(..len)?)
     }
 
+    /// Makes `changed` these settings, kept in `store` first so they survive a restart (a board
+    /// without a store keeps them until it restarts). A flash that fails changes nothing.
+    pub fn replace_kept(
+        &mut self,
+        changed: Self,
+        store: Option<&mut dyn ParamStore>,
+    ) -> Result<(), StoreError> {
+        if let Some(store) = store {
+            changed.save(store)?;
+        }
+        *self = changed;
+        Ok(())
+    }
+
     /// Keeps these settings in `store`, so they survive a restart.
     pub fn save(&self, store: &mut dyn ParamStore) -> Result<(), StoreError> {
         store.store(COLLISION_SETTINGS_KEY, &self.to_bytes())

@@ -10,13 +10,12 @@
 
 use protocol_core::Frame;
 use protocol_core::command::{
-    DataWidth, Direction, EndType, MoveMode, PinMode as WirePinMode, PositionTarget, Reply,
-    Request, ServoErrorCode, ServoSelect, cmd,
+    DataWidth, Direction, EndType, MoveMode, PinMode as WirePinMode, Reply, Request,
+    ServoErrorCode, ServoSelect, cmd,
 };
 use protocol_core::units::{Centideg, Decideg};
 
 use crate::cartesian::for_client;
-use crate::collision::CollisionSettings;
 use crate::config::{GRIPPER, JOINTS, SERVOS, in_encoder_range};
 use crate::context::Context;
 use crate::error::AtomError;
@@ -25,9 +24,8 @@ use crate::io::{AtomIo, PinMode, is_output_pin, mode_allowed};
 use crate::link::Link;
 use crate::motion::{Command, JogDirection, Target};
 use crate::parts::Parts;
-use crate::settings::Settings;
 use crate::waiting::WaitingRead;
-use crate::{backup, gains, gripper, registers, tolerance};
+use crate::{backup, gains, gripper, registers};
 
 /// Reported by get system version (0x02): 7.0, the vendor's 280 M5 generation.
 const SYSTEM_VERSION_X10: u8 = 70;
@@ -83,21 +81,6 @@ fn done_if(ok: bool) -> Answer {
 
 fn done() -> Answer {
     Answer::Done(Ok(()))
-}
-
-/// Makes `changed` the collision settings, kept in the flash the board lends so they survive
-/// a restart (a board without a store keeps them until it restarts). A flash that fails
-/// refuses the change: nothing changes.
-fn adopt_collision_settings<I: AtomIo>(
-    settings: &mut Settings,
-    changed: CollisionSettings,
-    io: &mut I,
-) -> Result<(), AtomError> {
-    if let Some(store) = io.param_store() {
-        changed.save(store).map_err(|_| AtomError::Invalid)?;
-    }
-    *settings.collision_mut() = changed;
-    Ok(())
 }
 
 fn execute<I: AtomIo>(
@@ -232,16 +215,8 @@ fn execute<I: AtomIo>(
             done()
         }
         R::IsInPosition { target } => {
-            // Near the target and at rest: pymycobot's sync_send_angles returns as soon as this
-            // says 1, so a pose passed through on the way does not count.
-            let present = bank.present_angles(now_us, settings);
-            let near = match target {
-                PositionTarget::Angles(a) => tolerance::angles_match(&present, &a),
-                PositionTarget::Coords(pose) => {
-                    tolerance::coords_match(&settings.cart().forward(&present), &pose)
-                }
-            };
-            byte(near && !motion.is_moving(bank, now_us))
+            let cx = &Context::new(now_us, bank, settings);
+            byte(motion.in_position(cx, &target))
         }
         R::IsMoving => byte(motion.is_moving(bank, now_us)),
         // No solution: `00` (pymycobot then returns 0, never a list of angles) and error 32.
@@ -369,7 +344,7 @@ fn execute<I: AtomIo>(
             speed,
         } => {
             let speed = speed.map_or(settings.speed_percent(), |s| s.get());
-            let index = usize::from(servo.get()) - 1;
+            let index = servo.index();
             let cx = &mut Context::new(now_us, bank, settings);
             if index == GRIPPER {
                 return Answer::Done(gripper::move_steps(cx, encoder, speed));
@@ -381,7 +356,7 @@ fn execute<I: AtomIo>(
             Answer::Done(motion.command(cx, Command::Move(target)))
         }
         R::GetEncoder { servo } => {
-            let index = usize::from(servo.get()) - 1;
+            let index = servo.index();
             Answer::Now(Reply::Int16(bank.health(index).map_or(0, |h| h.position.0)))
         }
         R::SetEncoders { encoders, speed } => {
@@ -426,7 +401,7 @@ fn execute<I: AtomIo>(
         // --- servos ---
         R::IsServoEnabled { servo } => Answer::Now(Reply::ServoEnabled {
             servo,
-            enabled: bank.enabled(usize::from(servo.get()) - 1),
+            enabled: bank.enabled(servo.index()),
         }),
         R::AreAllServosEnabled => byte((0..JOINTS).all(|j| bank.enabled(j))),
         R::SetServoData {
@@ -434,7 +409,7 @@ fn execute<I: AtomIo>(
             address,
             value,
         } => {
-            let index = usize::from(servo.get()) - 1;
+            let index = servo.index();
             let cx = &mut Context::new(now_us, bank, settings);
             Answer::Done(registers::write(cx, motion, gripper, index, address, value))
         }
@@ -444,7 +419,7 @@ fn execute<I: AtomIo>(
             width,
         } => {
             let two_bytes = width == Some(DataWidth::Word);
-            let index = usize::from(servo.get()) - 1;
+            let index = servo.index();
             later(
                 registers::read(settings, index, address, two_bytes).and_then(|op| {
                     let read = WaitingRead::ServoData { two_bytes };
@@ -453,16 +428,16 @@ fn execute<I: AtomIo>(
             )
         }
         R::SetServoCalibration { servo } => {
-            let index = usize::from(servo.get()) - 1;
+            let index = servo.index();
             let cx = &mut Context::new(now_us, bank, settings);
             Answer::Done(registers::calibrate(cx, motion, gripper, index))
         }
         R::JointBrake { servo } => {
             let cx = &mut Context::new(now_us, bank, settings);
-            Answer::Done(registers::brake(cx, usize::from(servo.get()) - 1))
+            Answer::Done(registers::brake(cx, servo.index()))
         }
         R::ReleaseServo { servo, .. } => {
-            let index = usize::from(servo.get()) - 1;
+            let index = servo.index();
             if index < JOINTS {
                 motion.halt(&mut Context::new(now_us, bank, settings));
             }
@@ -470,9 +445,7 @@ fn execute<I: AtomIo>(
         }
         R::FocusServo { servo } => match servo {
             ServoSelect::All => done_if((0..SERVOS).all(|i| bank.set_torque(settings, i, true))),
-            ServoSelect::One(s) => {
-                done_if(bank.set_torque(settings, usize::from(s.get()) - 1, true))
-            }
+            ServoSelect::One(s) => done_if(bank.set_torque(settings, s.index(), true)),
         },
         R::GetServoSpeeds => Answer::Now(Reply::Int16x6(bank.per_joint(|h| h.speed_steps_per_s))),
         R::GetServoCurrents => Answer::Now(Reply::Int16x6(
@@ -501,7 +474,10 @@ fn execute<I: AtomIo>(
         R::SetCollisionMode { on } => {
             let mut changed = *settings.collision();
             changed.set_enabled(on);
-            Answer::Done(adopt_collision_settings(settings, changed, io))
+            let kept = settings
+                .collision_mut()
+                .replace_kept(changed, io.param_store());
+            Answer::Done(kept.map_err(|_| AtomError::Invalid))
         }
         R::GetCollisionMode => byte(settings.collision().enabled()),
         R::SetCollisionThreshold { joint, threshold } => {
@@ -509,7 +485,10 @@ fn execute<I: AtomIo>(
             if changed.set_threshold(joint.get(), threshold.get()).is_err() {
                 return Answer::Done(Err(AtomError::Invalid));
             }
-            Answer::Done(adopt_collision_settings(settings, changed, io))
+            let kept = settings
+                .collision_mut()
+                .replace_kept(changed, io.param_store());
+            Answer::Done(kept.map_err(|_| AtomError::Invalid))
         }
         R::GetCollisionThresholds => Answer::Now(Reply::Bytes6(settings.collision().thresholds())),
 

@@ -34,15 +34,6 @@ impl<'a> Context<'a> {
         }
     }
 
-    /// The one power check of every motion: [`AtomError::PoweredOff`] unless the arm is on.
-    pub fn require_power(&self) -> Result<(), AtomError> {
-        if self.bank.powered() {
-            Ok(())
-        } else {
-            Err(AtomError::PoweredOff)
-        }
-    }
-
     /// Present joint angles now ([`ServoBank::present_angles`]).
     pub fn present_angles(&self) -> [Centideg; JOINTS] {
         self.bank.present_angles(self.now_us, self.settings)

@@ -28,7 +28,7 @@ pub mod plan;
 mod stream;
 
 use heapless::Deque;
-use protocol_core::command::{MoveMode, Pose};
+use protocol_core::command::{MoveMode, Pose, PositionTarget};
 use protocol_core::units::Centideg;
 
 use crate::bank::ServoBank;
@@ -266,10 +266,15 @@ impl MotionController {
         self.last_host_cmd_us = now_us;
     }
 
-    /// Whether a new motion may start: the one check every motion passes first. Refused while
-    /// the arm is powered off, or after a collision until [`MotionController::unlock`].
+    /// Whether a new motion may start, checked before it is planned so that a refused command
+    /// changes nothing: every new motion of the joints passes here (moves, paths, jogs,
+    /// streams, resume, drags and goal-register writes). Refused while the arm is powered off,
+    /// or after a collision until [`MotionController::unlock`]. (Every goal, braking included,
+    /// then passes [`crate::safety::check`], which refuses any goal while powered off.)
     pub fn may_move(&self, cx: &Context<'_>) -> Result<(), AtomError> {
-        cx.require_power()?;
+        if !cx.bank.powered() {
+            return Err(AtomError::PoweredOff);
+        }
         self.lock.map_or(Ok(()), Err)
     }
 
@@ -452,6 +457,7 @@ impl MotionController {
 
     /// Resumes a paused move (0x28); nothing to do if none is paused.
     pub fn resume(&mut self, cx: &mut Context<'_>) -> Result<(), AtomError> {
+        self.may_move(cx)?;
         match self.paused.take() {
             Some(t) => self.replace(cx, Order::Move(t)),
             None => Ok(()),
@@ -514,6 +520,20 @@ impl MotionController {
     /// True at `now_us` while the arm moves: a motion runs or a joint reports moving.
     pub fn is_moving(&self, bank: &ServoBank, now_us: u64) -> bool {
         self.is_active() || bank.joints_moving(now_us)
+    }
+
+    /// True if the arm is at `target` (angles, or a pose in the selected frames, within
+    /// [`tolerance`]) and at rest (0x2A): pymycobot's `sync_send_angles` returns as soon as
+    /// this says so, so a pose passed through on the way does not count.
+    pub fn in_position(&self, cx: &Context<'_>, target: &PositionTarget) -> bool {
+        let present = cx.present_angles();
+        let near = match target {
+            PositionTarget::Angles(a) => tolerance::angles_match(&present, a),
+            PositionTarget::Coords(pose) => {
+                tolerance::coords_match(&cx.settings.cart().forward(&present), pose)
+            }
+        };
+        near && !self.is_moving(cx.bank, cx.now_us)
     }
 
     /// The joint angles the arm is going to (the present angles when idle).
