@@ -10,6 +10,7 @@
 //! * [`crate::dispenser::Dispenser`]: the accessory hobby servo (0xD4 / 0xD7).
 //! * [`crate::error::ErrorLog`]: the error state 0x07 reports.
 //! * [`crate::waiting::WaitingReads`]: requests whose replies wait for servo reads.
+//! * [`crate::collision::CollisionDetector`]: collision protection, fed from the state reads.
 //! * [`BusSchedule`]: who talks on the shared wire when; [`UsbLink`]: the Atom's own USB.
 //!
 //! [`crate::commands`] translates each request into calls on these parts.
@@ -96,7 +97,7 @@ impl Atom {
         p.errors.note(moved).ok();
         self.parts.drag.poll(now_us, &self.parts.bank);
         self.parts.dispenser.poll(now_us, io);
-        self.update_button(now_us, io);
+        self.update_button(io);
         self.schedule
             .start_next(now_us, bus, &mut self.parts.bank, &self.parts.settings);
     }
@@ -185,7 +186,7 @@ impl Atom {
     }
 
     /// Free mode: the button releases the joints while held (to move the arm by hand).
-    fn update_button<I: AtomIo>(&mut self, _now_us: u64, io: &mut I) {
+    fn update_button<I: AtomIo>(&mut self, io: &mut I) {
         let pressed = io.button_pressed();
         let p = &mut self.parts;
         if pressed != self.button_was_pressed && p.settings.free_mode() && p.bank.powered() {

@@ -64,7 +64,7 @@ pub fn reads(
     let indices = match servos {
         ServoSelect::All => 0..JOINTS,
         ServoSelect::One(s) => {
-            let i = usize::from(s.get()) - 1;
+            let i = s.index();
             i..i + 1
         }
     };

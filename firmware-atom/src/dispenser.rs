@@ -55,11 +55,6 @@ impl Dispenser {
             self.zero(io);
         }
     }
-
-    /// True while the servo turns.
-    pub fn is_turning(&self) -> bool {
-        self.turning_until_us.is_some()
-    }
 }
 
 #[cfg(test)]
@@ -78,10 +73,8 @@ mod tests {
         // A second request half way adds a revolution.
         assert_eq!(d.turn(1_000 + TURN_US / 2, &mut io), Ok(()));
         d.poll(1_000 + 2 * TURN_US - 1, &mut io);
-        assert!(d.is_turning());
         assert_eq!(io.accessory_servo_pulse_us, Some(TURN_PULSE_US));
         d.poll(1_000 + 2 * TURN_US, &mut io);
-        assert!(!d.is_turning());
         assert_eq!(io.accessory_servo_pulse_us, Some(STOP_PULSE_US));
     }
 
@@ -91,7 +84,6 @@ mod tests {
         let mut d = Dispenser::default();
         assert_eq!(d.turn(0, &mut io), Ok(()));
         assert!(d.zero(&mut io));
-        assert!(!d.is_turning());
         assert_eq!(io.accessory_servo_pulse_us, Some(STOP_PULSE_US));
     }
 }

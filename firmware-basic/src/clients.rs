@@ -130,16 +130,6 @@ impl NetworkClients {
         self.slots.iter().flatten().count() as u8
     }
 
-    /// The connected clients.
-    pub fn connected(&self) -> impl Iterator<Item = NetClient> + '_ {
-        self.slots.iter().enumerate().filter_map(|(index, slot)| {
-            slot.as_ref().map(|s| NetClient {
-                index: index as u8,
-                session: s.session,
-            })
-        })
-    }
-
     /// How many bytes `client` may send now (0 for a client that has gone).
     pub fn room(&self, client: NetClient) -> usize {
         self.slot(client)

@@ -1,8 +1,9 @@
 //! Looks after the Atom and keeps the status the LCD shows: makes sure the Atom is powered after
 //! boot, probes it (0x12) when it has been silent for a while, and watches the forwarder's
-//! events and the replies' deliveries for the status. It only observes: where a reply goes is
-//! the router's decision ([`crate::router`]), and its own requests (the probe, the power-on)
-//! go out only when the bus has nothing else to do.
+//! events and the replies' deliveries for the status. It decides nothing about the clients'
+//! traffic (where a reply goes is the router's decision, [`crate::router`]); it only asks the
+//! Atom its own questions (the probe, the boot power-on), which go out only when the bus has
+//! nothing else to do.
 //!
 //! The boot power-on never cuts a move short. The vendor transponder sends power on (0x10) at
 //! boot, and the Atom answers 0x10 by holding the arm where it is: a move the host started in

@@ -1,6 +1,6 @@
 //! Fixed-point kinematics of the myCobot 280 M5 (`docs/kinematics.md`): forward and closed-form
 //! inverse kinematics of the flange for the vendor DH table, tool and world frames, joint
-//! limits as data, and straight-line Cartesian paths.
+//! limits as data, and Cartesian paths: straight lines, rays (jogs), turns and circular arcs.
 //!
 //! Everything is integer arithmetic (no floating point, no allocation, no panics), so it runs
 //! the same on the host and on a core without an FPU. Inputs and outputs use the protocol's

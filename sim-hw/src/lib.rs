@@ -4,7 +4,8 @@
 //!
 //! * [`wire`]: the shared 1 Mbaud half-duplex bus (every station hears every byte, overlapping
 //!   transmissions garble each other, echo per station) and 115200 serial lines.
-//! * [`servo`]: a simulated STS servo: control table, instructions, trapezoidal motion, faults.
+//! * [`servo`]: a simulated STS servo: control table, instructions, trapezoidal motion, faults,
+//!   and contact: obstacles and pushes, the load they cause, the overload protection.
 //! * [`chain`]: servos daisy-chained on one bus, hearing it through one decoder.
 //!
 //! Time is always passed in (nanoseconds); nothing here reads a clock.

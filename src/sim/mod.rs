@@ -3,7 +3,9 @@
 //!
 //! * [`wire`]: the shared 1 Mbaud half-duplex bus (every station hears every byte, overlapping
 //!   transmissions garble each other, echo per station) and 115200 serial lines.
-//! * [`servo`]: a simulated STS servo: control table, instructions, trapezoidal motion, faults.
+//! * [`servo`]: a simulated STS servo: control table, instructions, trapezoidal motion, faults,
+//!   contact (obstacles, pushes, the load they cause).
+//! * [`contact`]: obstacles in a joint's way (`--obstacle J:DEG`).
 //! * [`external`]: the same bus and servos serving boards that run elsewhere (the real images on
 //!   an emulated chip), whole frames in and the bus's bytes, echo included, out.
 //! * [`VirtualRobot`]: the real `firmware_basic::Basic` and `firmware_atom::Atom` wired to seven
@@ -19,7 +21,9 @@
 //! * drive it in real time: call [`VirtualRobot::run_until`] with the wall clock;
 //! * break things: [`SimServo::set_faults`] (no answer, bad checksum, stall, overheat),
 //!   [`SimServo::power_cycle`], [`SimServo::move_by_hand`], [`VirtualRobot::inject_bus_noise`],
-//!   [`VirtualRobot::reset_atom`], [`VirtualRobot::reset_basic`], and [`RobotConfig`] for echo
+//!   [`VirtualRobot::reset_atom`], [`VirtualRobot::reset_basic`], [`VirtualRobot::add_obstacle`]
+//!   and [`VirtualRobot::push_joint`] (contact, felt by the Atom's collision protection,
+//!   [`VirtualRobot::collisions`]), and [`RobotConfig`] for echo
 //!   wiring, a robot without a Basic, and the firmware configurations;
 //! * look: [`VirtualRobot::measured_angles`] (where the shafts really are),
 //!   [`VirtualRobot::shaft_angles_deg`] and [`measure`] (the flange's true pose), the servos' tables

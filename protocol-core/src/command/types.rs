@@ -51,12 +51,18 @@ checked_byte!(
 );
 
 checked_byte!(
-    /// A servo on the bus, 1..=7: the six joints and the gripper servo (7); also its bus id.
+    /// A servo of the arm, 1..=7: the six joints and the gripper servo (7). The Atom maps it
+    /// onto a bus id (`AtomConfig::servo_ids`, the same numbers on a factory arm).
     ServoId(1..=7),
     "servo"
 );
 
 impl ServoId {
+    /// Zero-based index into a seven-servo array, 0..=6 (6 = the gripper).
+    pub const fn index(self) -> usize {
+        self.0 as usize - 1
+    }
+
     /// The arm joint this servo drives, or `None` for the gripper.
     pub const fn joint(self) -> Option<JointId> {
         JointId::new(self.0)
@@ -494,11 +500,6 @@ checked_byte!(
     GripperType(1..=5),
     "gripper model"
 );
-
-impl GripperType {
-    /// The adaptive gripper, the default.
-    pub const ADAPTIVE: Self = Self(1);
-}
 
 /// The optional tail of 0x66/0x67: nothing, a gripper type, or a type and a torque flag.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
