@@ -19,7 +19,8 @@
 //! position loop wants the shaft (the setpoint); the shaft is there unless something holds it.
 //! A rigid stop keeps the shaft on its side; an external torque deflects a held shaft until the
 //! motor's torque balances it, and drives it along once the push is stronger than the torque
-//! limit (register 48). A new goal is planned from where the shaft is. The motor's torque is the position loop's: [`STIFFNESS_PER_P`] x P
+//! limit (register 48). A new goal is planned from the setpoint on, whatever holds the shaft
+//! (the profile is continuous, as a servo's trajectory generator is). The motor's torque is the position loop's: [`STIFFNESS_PER_P`] x P
 //! (register 21) per step between setpoint and shaft, capped at the torque limit. It shows as
 //! the present load (register 60, thousandths of the maximum torque; a moving shaft adds
 //! [`FREE_MOVING_LOAD`] and its inertia, [`INERTIA_LOAD_AT_MAX_ACCEL`] at full acceleration) and current (69); a load
@@ -763,7 +764,9 @@ impl SimServo {
         } else {
             1
         };
-        let moving = torque && (speed != 0 || goal.abs_diff(present) > 1);
+        // The servo moves while its profile runs, even if something holds the shaft.
+        let profile_running = self.setpoint_velocity != 0.0;
+        let moving = torque && (speed != 0 || profile_running || goal.abs_diff(present) > 1);
         let mut status = 0;
         if stalled || (self.overload_tripped && torque) {
             status |= fault::OVERLOAD;
@@ -912,10 +915,6 @@ impl SimServo {
             }
         }
         if goal_written {
-            // A new goal is planned from where the shaft is (a stop may hold it short of the
-            // old setpoint), at the speed it turns.
-            self.setpoint_steps = self.raw_position_steps;
-            self.setpoint_velocity = self.velocity_steps_per_s;
             self.stats.goal_writes += 1;
             let min = self.reg_u16(reg::MIN_POSITION);
             let max = self.reg_u16(reg::MAX_POSITION);
@@ -1629,8 +1628,9 @@ mod tests {
         rig.write(1, reg::MOVE_BLOCK, &move_block(0, 1000, 0));
         rig.run_for_ms(500);
         assert_eq!(position_load_status(&mut rig).0, 1800);
+        // The setpoint went on to 1000; it comes back at full acceleration (about 0.5 s).
         rig.write(1, reg::MOVE_BLOCK, &move_block(0, 1800, 0));
-        rig.run_for_ms(300);
+        rig.run_for_ms(700);
         let (_, load, _) = position_load_status(&mut rig);
         assert!(load.abs() < 100, "no more pressing: {load}");
         rig.write(1, reg::MOVE_BLOCK, &move_block(0, 2500, 0));
