@@ -6,9 +6,11 @@
 //!   at 30 deg (`--obstacle 2:30`): the time from the joint reaching the obstacle to the
 //!   collision (the detecting state read), how far past the contact point its servo was
 //!   driving it at the deepest (what a soft obstacle, a hand, would be pressed in by), and how
-//!   far past the contact its goal is once the arm is at rest.
-//! * **Push at rest**: the lightest push on joint 3 of a holding arm that is felt within 0.5 s
-//!   (in steps of 50 thousandths of the servo's maximum torque).
+//!   far past the contact its goal is once the arm is at rest. Then the same time for a
+//!   straight line whose joint 3 runs into an obstacle, and for a 50 Hz `send_angles` stream
+//!   driving joint 2 into one.
+//! * **Pushes**: the lightest push felt within 0.5 s (in steps of 50 thousandths of the servo's
+//!   maximum torque) on joint 3 of a holding arm, and against joint 1 while it moves.
 //! * **False alarms**: collisions raised by a corpus of motions that touch nothing: 40 random
 //!   joint moves across the workspace at speeds 20..=100, four straight lines, a 4 s 50 Hz
 //!   send_angles stream, joint jogs at 30, 60 and 100 % and Cartesian jogs ended by a stop, the
@@ -121,6 +123,112 @@ fn detect_once(threshold: u8, percent: u8) -> Option<(f64, f64, f64)> {
     ))
 }
 
+/// Runs `robot` in 100 us steps for up to 3 s, calling `drive` at each step with the time run
+/// so far (us), until 100 ms after a collision; the time from the servo `servo_id` first being
+/// held by its obstacle to the collision, ms.
+fn contact_to_detection(
+    robot: &mut VirtualRobot,
+    servo_id: u8,
+    mut drive: impl FnMut(&mut VirtualRobot, u64),
+) -> Result<f64, &'static str> {
+    let mut contact_ns = None;
+    for step in 0..30_000u64 {
+        drive(robot, step * 100);
+        robot.run_for(100);
+        if contact_ns.is_none() && robot.servo(servo_id).is_some_and(|s| s.blocked()) {
+            contact_ns = Some(robot.now_ns());
+        }
+        if let Some(&(at_ns, _)) = robot.collisions().first()
+            && robot.now_ns() > at_ns + 100_000_000
+        {
+            break;
+        }
+    }
+    match (contact_ns, robot.collisions().first()) {
+        (Some(contact), Some(&(detected, _))) if detected >= contact => {
+            Ok((detected - contact) as f64 / 1e6)
+        }
+        (_, Some(_)) => Err("a false alarm stopped it before the contact"),
+        (None, None) => Err("no contact"),
+        (Some(_), None) => Err("not detected"),
+    }
+}
+
+/// A straight line at speed 50 whose joint 3 runs into an obstacle at -40 deg.
+fn line_detection(threshold: u8) -> Result<f64, &'static str> {
+    let mut robot = armed(threshold);
+    let start = [0, -2_000, -3_000, -1_000, 0, 0].map(Centideg);
+    ask(
+        &mut robot,
+        Request::SendAngles {
+            angles: start,
+            speed: speed(100),
+        },
+    );
+    wait_until_still(&mut robot, 5_000_000);
+    robot.add_obstacle(Obstacle {
+        joint: 3,
+        angle: Centideg(-4_000),
+    });
+    let through = [0, 8_000, -3_000, -1_000, 0, 0].map(Centideg);
+    let Reply::Coords(pose) = ask(&mut robot, Request::AnglesToCoords { angles: through }) else {
+        panic!("angles to coords")
+    };
+    let line = Request::SendCoords {
+        pose,
+        speed: speed(50),
+        mode: Some(MoveMode::Linear),
+    };
+    if robot.ask(&line) != Ok(Reply::Ack) {
+        return Err("refused: a false alarm on the way to the start");
+    }
+    contact_to_detection(&mut robot, 3, |_, _| {})
+}
+
+/// A 50 Hz send_angles stream ramping joint 2 at 30 deg/s into an obstacle at 30 deg.
+fn stream_detection(threshold: u8) -> Result<f64, &'static str> {
+    let mut robot = armed(threshold);
+    robot.add_obstacle(Obstacle {
+        joint: 2,
+        angle: Centideg(3_000),
+    });
+    contact_to_detection(&mut robot, 2, |robot, t_us| {
+        if t_us % 20_000 == 0 {
+            let angle = Centideg(((t_us / 20_000 + 1) * 60).min(6_000) as i16);
+            let angles = [
+                Centideg(0),
+                angle,
+                Centideg(0),
+                Centideg(0),
+                Centideg(0),
+                Centideg(0),
+            ];
+            let sample = Request::SendAngles {
+                angles,
+                speed: speed(100),
+            };
+            robot.host_write(&sample.to_frame().to_bytes());
+        }
+        let mut replies = Vec::new();
+        robot.host_read(&mut replies);
+    })
+}
+
+fn paths_and_streams() {
+    println!(
+        "== detection in a line (joint 3 into an obstacle at -40 deg, speed 50) and in a 50 Hz send_angles stream (joint 2 at 30 deg/s into 30 deg)"
+    );
+    for threshold in THRESHOLDS {
+        let show =
+            |ms: Result<f64, &str>| ms.map_or_else(str::to_string, |ms| format!("{ms:5.1} ms"));
+        println!(
+            "threshold {threshold:3}: line {} | stream {}",
+            show(line_detection(threshold)),
+            show(stream_detection(threshold))
+        );
+    }
+}
+
 fn detection() {
     println!(
         "== detection: joint 2 from 0 towards 60 deg into an obstacle at 30 deg (target: <= 40 ms at speed 50, pressing <= 2 deg past the contact)"
@@ -139,11 +247,24 @@ fn detection() {
     }
 }
 
-/// The lightest push (thousandths of max torque) on joint 3 of a holding arm felt within 0.5 s.
-fn lightest_push_felt(threshold: u8) -> Option<i16> {
+/// The lightest push (thousandths of max torque, in steps of 50) felt within 0.5 s: on joint 3
+/// of a holding arm, or against joint 1 moving to 60 deg at speed 30 (pushed 0.2 s into the
+/// move, which lasts about 1.3 s).
+fn lightest_push_felt(threshold: u8, moving: bool) -> Option<i16> {
     (2..=20).map(|k| k * 50).find(|&push| {
         let mut robot = armed(threshold);
-        robot.push_joint(3, push);
+        if moving {
+            let to_60 = Request::SendAngle {
+                joint: joint(1),
+                angle: Centideg(6_000),
+                speed: speed(30),
+            };
+            ask(&mut robot, to_60);
+            robot.run_for(200_000);
+            robot.push_joint(1, -push);
+        } else {
+            robot.push_joint(3, push);
+        }
         robot.run_for(500_000);
         !robot.collisions().is_empty()
     })
@@ -151,13 +272,16 @@ fn lightest_push_felt(threshold: u8) -> Option<i16> {
 
 fn pushes() {
     println!(
-        "== push on joint 3 of a holding arm: the lightest felt within 0.5 s (thousandths of the servo's maximum torque)"
+        "== the lightest push felt within 0.5 s (thousandths of the servo's maximum torque): on joint 3 of a holding arm, against joint 1 moving at speed 30"
     );
     for threshold in THRESHOLDS {
-        match lightest_push_felt(threshold) {
-            Some(push) => println!("threshold {threshold:3}: {push}"),
-            None => println!("threshold {threshold:3}: none up to 1000"),
-        }
+        let show =
+            |push: Option<i16>| push.map_or("none up to 1000".to_string(), |p| p.to_string());
+        println!(
+            "threshold {threshold:3}: holding {} | moving {}",
+            show(lightest_push_felt(threshold, false)),
+            show(lightest_push_felt(threshold, true))
+        );
     }
 }
 
@@ -311,6 +435,7 @@ fn main() {
     let run = |name: &str| only.as_deref().is_none_or(|o| o == name);
     if run("detect") {
         detection();
+        paths_and_streams();
     }
     if run("push") {
         pushes();

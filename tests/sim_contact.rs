@@ -7,7 +7,7 @@ mod sim_support;
 use open_mycobot::sim::VirtualRobot;
 use open_mycobot::sim::contact::Obstacle;
 use protocol_core::Frame;
-use protocol_core::command::{JointId, Reply, Request};
+use protocol_core::command::{JointId, MoveMode, Reply, Request};
 use protocol_core::units::Centideg;
 use sim_support::*;
 
@@ -48,7 +48,14 @@ fn a_move_into_an_obstacle_is_stopped_as_a_collision_until_cleared() {
     let at = get_angles(&mut robot)[1].0;
     assert!((at - 3_000).abs() <= 20, "{at}");
     let servo = robot.servo(2).unwrap();
-    assert!(!servo.blocked(), "the goal was set back where it stands");
+    eprintln!(
+        "goal {} present {} setpoint {} collision {:?}",
+        servo.goal_position(),
+        servo.present_position(),
+        servo.setpoint_steps(),
+        robot.atom().collision()
+    );
+    assert!(!servo.blocked(), "the servo let go: it presses no more");
     // Further motion is refused with the code until cleared.
     let refused = robot.transact(&to_60.to_frame()).expect("an answer");
     assert_eq!(refused.data(), &[0], "refused");
@@ -147,4 +154,99 @@ fn settings_are_taken_in_range_refused_outside_and_survive_a_restart() {
     robot.run_for(1_000_000);
     assert_eq!(answer(&mut robot, 0xFD, &[]), [0]);
     assert_eq!(answer(&mut robot, 0x76, &[]), [100, 100, 250, 100, 100, 50]);
+}
+
+/// Runs until the Atom reports a collision, at most `timeout_us`; its error code.
+fn collision_code_within(robot: &mut VirtualRobot, timeout_us: u64) -> Option<u8> {
+    robot.run_until_true(timeout_us, |r| r.atom().collision().is_some());
+    robot.atom().collision().map(|c| c.code())
+}
+
+#[test]
+fn a_line_into_an_obstacle_is_a_cartesian_collision() {
+    let mut robot = arm();
+    let start = [0, -2_000, -3_000, -1_000, 0, 0].map(Centideg);
+    ack(
+        &mut robot,
+        Request::SendAngles {
+            angles: start,
+            speed: speed(100),
+        },
+    );
+    wait_until_stopped(&mut robot);
+    assert!(robot.add_obstacle("3:-40".parse::<Obstacle>().unwrap()));
+    let through = [0, 8_000, -3_000, -1_000, 0, 0].map(Centideg);
+    let Reply::Coords(pose) = ask(&mut robot, Request::AnglesToCoords { angles: through }) else {
+        panic!("angles to coords")
+    };
+    let line = Request::SendCoords {
+        pose,
+        speed: speed(50),
+        mode: Some(MoveMode::Linear),
+    };
+    ack(&mut robot, line);
+    assert_eq!(collision_code_within(&mut robot, 5_000_000), Some(17));
+    assert_eq!(robot.atom().collision().unwrap().joint, 2, "joint 3");
+    wait_until_stopped(&mut robot);
+    assert_eq!(ask(&mut robot, Request::GetErrorInfo), Reply::Byte(17));
+}
+
+#[test]
+fn a_stream_into_an_obstacle_is_stopped_while_it_streams() {
+    let mut robot = blocked_at_30();
+    // A ROS-like 50 Hz stream ramping joint 2 to 60 deg over 2 s.
+    for k in 1..=100i16 {
+        let angles = [0, k * 60, 0, 0, 0, 0].map(Centideg);
+        robot.host_write(
+            &Request::SendAngles {
+                angles,
+                speed: speed(100),
+            }
+            .to_frame()
+            .to_bytes(),
+        );
+        robot.run_for(20_000);
+        let mut replies = Vec::new();
+        robot.host_read(&mut replies);
+        if robot.atom().collision().is_some() {
+            break;
+        }
+    }
+    let collision = robot.atom().collision().expect("felt during the stream");
+    assert_eq!((collision.joint, collision.code()), (1, 16));
+    let at = robot.collisions()[0].0;
+    assert!(
+        at < 1_500_000_000 + 2_000_000_000,
+        "before the stream ended: {at} ns"
+    );
+}
+
+#[test]
+fn a_firm_push_against_a_moving_joint_is_felt_before_the_move_ends() {
+    let mut robot = arm();
+    let to_60 = Request::SendAngle {
+        joint: JointId::new(1).unwrap(),
+        angle: Centideg(6_000),
+        speed: speed(30),
+    };
+    ack(&mut robot, to_60);
+    robot.run_for(200_000);
+    assert!(robot.atom().is_moving());
+    assert!(robot.push_joint(1, -700));
+    assert_eq!(collision_code_within(&mut robot, 100_000), Some(16));
+    assert!(
+        robot.measured_angles()[0].0 < 5_000,
+        "long before it arrived"
+    );
+}
+
+#[test]
+fn power_on_ends_a_collision_and_its_error() {
+    let mut robot = blocked_at_30();
+    ack(&mut robot, joint_2_to(6_000));
+    assert_eq!(collision_code_within(&mut robot, 3_000_000), Some(16));
+    wait_until_stopped(&mut robot);
+    ack(&mut robot, Request::PowerOn);
+    assert_eq!(ask(&mut robot, Request::GetErrorInfo), Reply::Byte(0));
+    ack(&mut robot, joint_2_to(0));
 }

@@ -6,10 +6,12 @@
 //! present load) rises towards the torque limit. The detector watches each joint's load and
 //! speed: a load at or above the joint's limit ([`load_limit_permille`] of its threshold) on a
 //! shaft that is held back (turning slower than [`STALL_SPEED_STEPS`]) or driven back (turning
-//! against the motor's torque), in [`CONFIRM_READS`] state reads in a row (one read every
-//! ~4.4 ms), is a collision. Speeding the arm up loads a servo too, but the shaft turns with
-//! the torque then; an obstacle holds it, a push stronger than the motor drives it back. The
-//! gripper (servo 7) is not watched: it is made to press on what it holds.
+//! against the motor's torque), or a load [`MOVING_MARGIN_PERMILLE`] above the limit on a shaft
+//! that still turns (a push against a moving joint), in [`CONFIRM_READS`] state reads in a row
+//! (one read every ~4.4 ms), is a collision. Speeding the arm up loads a servo too, but the
+//! shaft turns with the torque then and the load stays below the margin; an obstacle holds the
+//! shaft, a push stronger than the motor drives it back. The gripper (servo 7) is not watched:
+//! it is made to press on what it holds.
 //!
 //! A detected collision is latched ([`CollisionDetector::collision`]) until cleared (0x08 clear
 //! error information, or 0x10 power on); the Atom stops the arm, sets the blocked joint's goal
@@ -36,8 +38,12 @@ pub const DEFAULT_PROTECTION: bool = true;
 pub const DEFAULT_THRESHOLD: u8 = 100;
 /// A shaft turning slower than this (steps/s, 8.8 deg/s) while it presses is held back.
 pub const STALL_SPEED_STEPS: i16 = 100;
-/// State reads in a row that must show a pressing, held-back joint.
+/// State reads in a row that must show a pressing joint.
 pub const CONFIRM_READS: u8 = 2;
+/// How far above its limit the load of a joint that still turns must be to count as pressing:
+/// more than speeding the arm up ever needs (thousandths of the servo's maximum torque), so a
+/// push against a moving joint is felt before the move ends.
+pub const MOVING_MARGIN_PERMILLE: i16 = 250;
 
 /// The present load (thousandths of the servo's maximum torque) at which a joint with
 /// `threshold` counts as pressing: 350 at 50, 500 at the default 100, 950 at 250. Free motion
@@ -241,11 +247,12 @@ impl CollisionDetector {
             && state.fault_bits & fault::OVERLOAD == 0;
         let load = state.load_permille;
         let speed = state.speed_steps_per_s;
+        let limit = load_limit_permille(settings.threshold(joint));
         let held_back = speed.saturating_abs() < STALL_SPEED_STEPS;
         let driven_back = i32::from(load) * i32::from(speed) < 0;
         let pressing = watched
-            && load.saturating_abs() >= load_limit_permille(settings.threshold(joint))
-            && (held_back || driven_back);
+            && (load.saturating_abs() >= limit && (held_back || driven_back)
+                || load.saturating_abs() >= limit.saturating_add(MOVING_MARGIN_PERMILLE));
         *count = if pressing { count.saturating_add(1) } else { 0 };
         if *count < CONFIRM_READS {
             return None;
@@ -351,6 +358,26 @@ mod tests {
         );
         let pushed = detector.on_state(1, 2, 1, &driven, &ON, Kind::Holding);
         assert_eq!(pushed.map(|c| c.code()), Some(18));
+    }
+
+    #[test]
+    fn a_moving_joint_loaded_far_beyond_its_limit_is_pushed() {
+        let mut detector = CollisionDetector::default();
+        let pushed = state(760, 600);
+        assert_eq!(
+            detector.on_state(0, 0, 0, &pushed, &ON, Kind::JointMotion),
+            None
+        );
+        let felt = detector.on_state(1, 0, 1, &pushed, &ON, Kind::JointMotion);
+        assert_eq!(felt.map(|c| c.code()), Some(16));
+        let mut just_below = CollisionDetector::default();
+        for t in 0..5 {
+            let read = state(749, 600);
+            assert_eq!(
+                just_below.on_state(t, 0, t, &read, &ON, Kind::JointMotion),
+                None
+            );
+        }
     }
 
     #[test]

@@ -10,7 +10,7 @@ use protocol_core::units::Centideg;
 use crate::bank::ServoBank;
 use crate::config::JOINTS;
 use crate::error::AtomError;
-use crate::safety::{Goal, Goals};
+use crate::safety::Goals;
 use crate::settings::Settings;
 
 /// The parts lent to one step. See the [module doc](self).
@@ -44,21 +44,16 @@ impl<'a> Context<'a> {
         self.bank.joints_moving(self.now_us)
     }
 
-    /// Sets joint `index`'s goal where its shaft stands now (its last read position), at the
-    /// servos' full acceleration: a servo held back by something stops pressing on it. Nothing
-    /// is sent for a joint that has not been read.
-    pub fn hold_where_it_stands(&mut self, index: usize) {
-        let Some(position) = self.bank.health(index).map(|h| h.position) else {
-            return;
-        };
-        let config = self.settings.config();
-        let goal = Goal {
-            position,
-            speed_steps_per_s: config.joint_speed_steps(100) as u16,
-            accel: config.servo_accel_register(),
-        };
-        // A refusal (powered off, outside the limits) leaves the goal the stop sent.
-        self.send_goals(Goals::one(index, goal)).ok();
+    /// Makes joint `index`'s servo let go of what it presses on and hold where its shaft
+    /// stands: its torque is switched off and on again, which restarts its position loop at
+    /// the shaft (a new goal alone would let the servo's profile run on into the obstacle
+    /// while it slows down) and drops a goal not yet written. Nothing happens to a joint that
+    /// has not been read (it cannot be switched on holding a known place).
+    pub fn let_go_and_hold(&mut self, index: usize) {
+        if self.bank.health(index).is_some_and(|h| h.answering) {
+            self.bank.set_torque(self.settings, index, false);
+            self.bank.set_torque(self.settings, index, true);
+        }
     }
 
     /// Checks `goals` and makes them the next goals written ([`ServoBank::send_goals`]).

@@ -76,8 +76,11 @@ impl Parts {
     }
 
     /// Forgets a collision (0x08 clear error information, 0x10 power on): motion is allowed
-    /// again.
+    /// again, and 0x07 no longer reports it.
     pub fn clear_collision(&mut self) {
+        if self.collision.collision().is_some() {
+            self.errors.clear();
+        }
         self.collision.clear();
         self.motion.unlock();
     }

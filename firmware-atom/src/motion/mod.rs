@@ -470,12 +470,12 @@ impl MotionController {
         self.brake(cx, None);
     }
 
-    /// Reacts to `collision`: every joint brakes as for a stop, the blocked joint's goal is set
-    /// where it stands (its servo stops pressing), and new motion is refused with the
-    /// collision's code until [`MotionController::unlock`].
+    /// Reacts to `collision`: every joint brakes as for a stop, the blocked joint's servo lets
+    /// go and holds where it stands ([`Context::let_go_and_hold`]: it stops pressing), and new
+    /// motion is refused with the collision's code until [`MotionController::unlock`].
     pub fn collided(&mut self, cx: &mut Context<'_>, collision: &Collision) {
         self.stop(cx);
-        cx.hold_where_it_stands(collision.joint);
+        cx.let_go_and_hold(collision.joint);
         self.lock = Some(AtomError::Collision(collision.kind));
     }
 
