@@ -20,7 +20,7 @@ use crate::tolerance;
 
 mod readback;
 
-use readback::{STATE_READ_ADDR, STATE_READ_LEN, apply_state};
+use readback::{Repair, STATE_READ_ADDR, STATE_READ_LEN, apply_state, repair};
 
 /// Servo operations waiting for the bus. 24: a command queues at most 3 (EEPROM unlock,
 /// write, lock), 7 (torque for every servo) or 24 (a restore of all six joints: a read, then
@@ -332,6 +332,53 @@ impl ServoBank {
             }
         }
         self.hold_pending(settings, waiting.merge(safe.goals()))
+    }
+
+    /// Re-sends what servo `index`'s read-back shows got lost ([`readback::repair`]): its
+    /// torque, or its last goal (through the safety check again: the limits may have changed
+    /// since).
+    fn verify(&mut self, settings: &Settings, index: usize) {
+        let Some(&id) = settings.config().servo_ids.get(index) else {
+            return;
+        };
+        let Some(s) = self.servos.get(index).copied() else {
+            return;
+        };
+        let pending_goal = self
+            .pending
+            .as_ref()
+            .is_some_and(|p| p.goals().get(index).is_some());
+        let pending_job = self.jobs.iter().any(|j| j.op.id() == id);
+        match repair(
+            &s.health,
+            s.last_goal,
+            s.repairs,
+            pending_goal || pending_job,
+        ) {
+            Some(Repair::Torque(on)) => {
+                let op = if on {
+                    self.torque_on_op(settings, index, id)
+                } else {
+                    Op::write(id, reg::TORQUE_ENABLE, &[0])
+                };
+                if let Some(op) = op {
+                    self.queue_op(op);
+                }
+            }
+            Some(Repair::Goal(goal)) => {
+                let waiting = self.pending.as_ref().map_or(Goals::NONE, |p| *p.goals());
+                if self
+                    .hold_pending(settings, waiting.merge(&Goals::one(index, goal)))
+                    .is_err()
+                {
+                    return;
+                }
+            }
+            None => return,
+        }
+        if let Some(s) = self.servos.get_mut(index) {
+            s.repairs += 1;
+        }
     }
 
     /// Makes `goals` the goals not written yet, through the safety check again: the limits

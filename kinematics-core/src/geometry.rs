@@ -1,8 +1,8 @@
 //! The arm's link geometry (standard DH, `docs/kinematics.md`) and the forward chain of link
 //! transforms. The parameters live here and only here, so a calibrated set can replace them.
 
-use crate::JointAngles;
 use crate::fixed::{Angle, ONE};
+use crate::pose::JointAngles;
 use crate::transform::{LEN_PER_TENTH_MM, Len, Rotation, Transform};
 
 /// Internal length units per micrometre.

@@ -18,10 +18,26 @@
 //! Every acos is computed as atan2(sqrt(max(0, ...)), ...) with a small reach tolerance, so the
 //! stretched elbow (q3 = 0) and the shoulder singularity (both present at the zero pose) solve.
 
-use crate::IkError;
 use crate::fixed::{Angle, atan2, mul, sqrt};
 use crate::geometry::Links;
 use crate::transform::{LEN_PER_TENTH_MM, Len, Transform};
+
+/// Why a pose has no joint solution (protocol error 32, see [`IkError::PROTOCOL_CODE`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IkError {
+    /// The pose is out of the arm's reach (too far, or too close to the J1 axis).
+    Unreachable,
+    /// The pose is reachable, but every branch puts some joint outside its limits.
+    OutsideLimits,
+    /// The geometry degenerates (the two-link chain folds onto the J2 axis) so the joints are
+    /// not determined; impossible with the vendor link lengths, kept for calibrated ones.
+    Singular,
+}
+
+impl IkError {
+    /// The 0x07 error code for "IK has no solution".
+    pub const PROTOCOL_CODE: u8 = 32;
+}
 
 /// How far (0.2 mm) a target may lie beyond the arm's reach, or inside the shoulder's dead
 /// cylinder, and still be solved as the nearest reachable pose: the wire's 0.1 mm rounding puts

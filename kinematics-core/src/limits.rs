@@ -1,6 +1,6 @@
 //! Joint limits as run-time data, and wrapping an angle by +-360 deg into them.
 
-use crate::JointAngles;
+use crate::pose::JointAngles;
 
 /// Centidegrees in a full turn.
 const TURN_CENTIDEG: i32 = 36_000;

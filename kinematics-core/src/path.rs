@@ -1,5 +1,5 @@
 //! Cartesian paths: where the end goes (a [`Path`]: a straight [`Line`], a [`Ray`] along a base
-//! axis, a [`Turn`] about one, an [`Arc`] through three poses) and how joint angles follow it
+//! axis, a [`Turn`] about one, an [`Arc`](arc::Arc) through three poses) and how joint angles follow it
 //! ([`PathWalker`], and [`check_path`] to walk a whole path coarsely before moving).
 //!
 //! A path is a pose for every point along it, measured in micrometres of travel, a degree of
@@ -12,11 +12,11 @@
 
 pub mod arc;
 
-pub use arc::Arc;
-
 use crate::fixed::{Angle, ratio};
+use crate::ik::IkError;
+use crate::model::Kinematics;
+use crate::pose::{JointAngles, Pose};
 use crate::transform::{LEN_PER_TENTH_MM, Rotation, Transform};
-use crate::{IkError, JointAngles, Kinematics, Pose};
 
 /// Default for [`LinearPath::with_max_joint_step`]: 5 deg, a few interpolation periods of a joint
 /// at full speed; ordinary steps of a few millimetres need well under 2 deg.
@@ -48,7 +48,7 @@ pub enum PathError {
     /// A step has no solution at all (out of reach or limits on the way).
     StepUnreachable(IkError),
     /// The three points of an arc define no circle: two of them coincide, or they lie on one
-    /// line ([`Arc::through`]).
+    /// line ([`Arc::through`](arc::Arc::through)).
     NoCircle,
 }
 

@@ -1,8 +1,8 @@
 //! Rigid transforms in fixed point: rotation matrices in Q30, positions in [`Len`] units, and the
 //! conversion to and from the wire's [`Pose`] (0.1 mm, 0.01 deg, R = Rz(rz) * Ry(ry) * Rx(rx)).
 
-use crate::Pose;
 use crate::fixed::{Angle, ONE, atan2, mul, ratio, sqrt};
+use crate::pose::Pose;
 
 /// Internal length unit: 1/16 micrometre, i.e. this many units per 0.1 mm. Fine enough that
 /// rounding never shows at the wire's 0.1 mm; coarse enough that a Q30 rotation times a

@@ -3,11 +3,8 @@
 use protocol_core::servo::{Packet, reg, sign_magnitude};
 use protocol_core::units::Steps;
 
-use super::ServoBank;
-use crate::driver::Op;
 use crate::health::ServoHealth;
-use crate::safety::Goals;
-use crate::settings::Settings;
+use crate::safety::Goal;
 use crate::tolerance;
 
 /// First register of the state read: torque enable (40) through present current (69..70), so
@@ -43,53 +40,36 @@ pub(super) fn apply_state(h: &mut ServoHealth, p: &Packet) {
     h.goal_reported = Steps(sign_magnitude(word(reg::GOAL_POSITION), 15));
 }
 
-impl ServoBank {
-    /// Compares what servo `index` reports with what it was told (torque, goal) and re-sends
-    /// what got lost: a SYNC WRITE has no answer, and a collision on the shared wire can
-    /// swallow it or a torque write. At most [`MAX_REPAIRS`] corrections per command, and
-    /// none while a command for that servo is still on its way.
-    pub(super) fn verify(&mut self, settings: &Settings, index: usize) {
-        let Some(&id) = settings.config().servo_ids.get(index) else {
-            return;
-        };
-        let Some(s) = self.servos.get(index).copied() else {
-            return;
-        };
-        let h = s.health;
-        let pending_goal = self
-            .pending
-            .as_ref()
-            .is_some_and(|p| p.goals().get(index).is_some());
-        let pending_job = self.jobs.iter().any(|j| j.op.id() == id);
-        if pending_goal || pending_job || s.repairs >= MAX_REPAIRS {
-            return;
+/// What a servo's read-back asks the bank to send again.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Repair {
+    /// Its torque is not what it was told: write torque on (`true`) or off again.
+    Torque(bool),
+    /// It holds torque but not the goal it was last sent: send that goal again (through the
+    /// safety check: the limits may have changed since).
+    Goal(Goal),
+}
+
+/// Compares what a servo reports (`h`) with what it was told (torque, `last_goal`) and says
+/// what got lost: a SYNC WRITE has no answer, and a collision on the shared wire can swallow
+/// it or a torque write. Nothing after [`MAX_REPAIRS`] corrections (`repairs`) for the same
+/// command, nor while a command for that servo is still on its way (`busy`).
+pub(super) fn repair(
+    h: &ServoHealth,
+    last_goal: Option<Goal>,
+    repairs: u8,
+    busy: bool,
+) -> Option<Repair> {
+    if busy || repairs >= MAX_REPAIRS {
+        return None;
+    }
+    if h.torque_reported != h.torque_on {
+        return Some(Repair::Torque(h.torque_on));
+    }
+    match last_goal {
+        Some(goal) if h.torque_on && !tolerance::goal_confirmed(goal.position, h.goal_reported) => {
+            Some(Repair::Goal(goal))
         }
-        if h.torque_reported != h.torque_on {
-            let op = if h.torque_on {
-                self.torque_on_op(settings, index, id)
-            } else {
-                Op::write(id, reg::TORQUE_ENABLE, &[0])
-            };
-            if let Some(op) = op {
-                self.queue_op(op);
-            }
-        } else if h.torque_on
-            && let Some(goal) = s.last_goal
-            && !tolerance::goal_confirmed(goal.position, h.goal_reported)
-        {
-            let waiting = self.pending.as_ref().map_or(Goals::NONE, |p| *p.goals());
-            // Through the safety check again: the limits may have changed since.
-            if self
-                .hold_pending(settings, waiting.merge(&Goals::one(index, goal)))
-                .is_err()
-            {
-                return;
-            }
-        } else {
-            return;
-        }
-        if let Some(s) = self.servos.get_mut(index) {
-            s.repairs += 1;
-        }
+        _ => None,
     }
 }

@@ -24,21 +24,15 @@ use super::wire::Writer;
 mod fields;
 mod table;
 
+pub use fields::MAX_DRAG_SPEED;
+
 use fields::Fields;
 use table::requests;
 
-/// Highest encoder value a client may send (pymycobot allows 0..=4096).
-pub const MAX_ENCODER: i16 = 4096;
-/// Highest per-servo drag speed of 0x3E, steps per second (pymycobot: 0..=6000).
-pub const MAX_DRAG_SPEED: i16 = 6000;
 /// Allowed HTS gripper torque range of 0x35 (pymycobot: 150..=980).
 pub const HTS_TORQUE_RANGE: core::ops::RangeInclusive<i16> = 150..=980;
 /// Allowed gripper protect current range of 0x39 (pymycobot: 1..=500).
 pub const PROTECT_CURRENT_RANGE: core::ops::RangeInclusive<i16> = 1..=500;
-/// Servo registers below this address (firmware version, model) are refused by set servo data
-/// (0x52), as pymycobot does. Reading them is allowed (pymycobot's `is_torque_gripper` reads
-/// register 1 of servo 7).
-pub const MIN_SERVO_ADDRESS: u8 = 5;
 
 requests! {
     /// One host command, typed and validated: every field holds a value the protocol allows.

@@ -43,7 +43,7 @@ esp_bootloader_esp_idf::esp_app_desc!();
 #[main]
 fn main() -> ! {
     let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
-    let pins = pins::take_pins!(p);
+    let pins = pins::chip::take_pins!(p);
     board_log!("open-mycobot atom {}", env!("CARGO_PKG_VERSION"));
 
     let bus_uart = Uart::new(p.UART1, board_support::uart_port::config(BUS_BAUD))

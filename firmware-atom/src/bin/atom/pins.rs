@@ -1,7 +1,7 @@
 //! Which GPIO does what, per chip. The only chip-specific code of the board binary.
 //!
-//! Each chip module defines `take_pins!(peripherals)`, which moves the pins out of esp-hal's
-//! `Peripherals` into an [`AtomPins`].
+//! Each chip module ([`chip`]) defines `take_pins!(peripherals)`, which moves the pins out of
+//! esp-hal's `Peripherals` into an [`AtomPins`].
 
 use esp_hal::gpio::AnyPin;
 
@@ -29,10 +29,8 @@ pub struct AtomPins {
 
 #[cfg(feature = "esp32")]
 #[path = "pins_esp32.rs"]
-mod chip;
+pub(crate) mod chip;
 
 #[cfg(feature = "esp32c3")]
 #[path = "pins_esp32c3.rs"]
-mod chip;
-
-pub(crate) use chip::take_pins;
+pub(crate) mod chip;

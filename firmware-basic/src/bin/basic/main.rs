@@ -82,7 +82,7 @@ const HEAP_BYTES: usize = 36 * 1024;
 #[main]
 fn main() -> ! {
     let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
-    let mut pins = pins::take_pins!(p);
+    let mut pins = pins::chip::take_pins!(p);
     // Through the embedded-hal trait, so this line means the same on every chip: a fixed output
     // is an `Output` on the ESP32 and a `NoPin` on the C3 stand-in, both infallible.
     let Ok(()) = OutputPin::set_low(&mut pins.speaker);

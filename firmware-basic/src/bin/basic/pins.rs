@@ -1,12 +1,19 @@
 //! Which GPIO does what, per chip. The only chip-specific code of the board binary.
 //!
-//! Each chip module defines `take_pins!(peripherals)`, which moves the pins out of esp-hal's
-//! `Peripherals` into a [`BasicPins`], and [`chip::FixedOutput`], the type of the outputs a
-//! board may have wired to a fixed level instead of a GPIO (LCD reset and backlight, speaker).
+//! Each chip module ([`chip`]) defines `take_pins!(peripherals)`, which moves the pins out of
+//! esp-hal's `Peripherals` into a [`BasicPins`]; [`FixedOutput`] (per chip, here) is the type of
+//! the outputs a board may have wired to a fixed level instead of a GPIO (LCD reset and
+//! backlight, speaker).
 
 use esp_hal::gpio::AnyPin;
 
-pub use chip::FixedOutput;
+/// An output on a GPIO.
+#[cfg(feature = "esp32")]
+pub type FixedOutput = esp_hal::gpio::Output<'static>;
+
+/// On the C3 stand-in, an output wired to a fixed level: writes to it do nothing.
+#[cfg(feature = "esp32c3")]
+pub type FixedOutput = esp_hal::gpio::NoPin;
 
 /// The Basic's pins by function.
 pub struct BasicPins {
@@ -42,10 +49,8 @@ pub struct BasicPins {
 
 #[cfg(feature = "esp32")]
 #[path = "pins_esp32.rs"]
-mod chip;
+pub(crate) mod chip;
 
 #[cfg(feature = "esp32c3")]
 #[path = "pins_esp32c3.rs"]
-mod chip;
-
-pub(crate) use chip::take_pins;
+pub(crate) mod chip;

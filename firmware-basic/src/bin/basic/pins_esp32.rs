@@ -1,8 +1,5 @@
 //! The real M5Stack Basic (ESP32), as in `docs/boards.md`.
 
-/// An output on a GPIO.
-pub type FixedOutput = esp_hal::gpio::Output<'static>;
-
 /// Moves the Basic's pins out of `$p` (esp-hal `Peripherals`).
 macro_rules! take_pins {
     ($p:ident) => {{

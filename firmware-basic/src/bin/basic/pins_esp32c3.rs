@@ -3,9 +3,6 @@
 //! UART0 on the C3's default GPIO21/20, the buttons on GPIO9 (BOOT), 3 and 10, the LCD's reset
 //! tied to the chip's reset, its backlight always on, and no speaker.
 
-/// An output the stand-in board wires to a fixed level: writes to it do nothing.
-pub type FixedOutput = esp_hal::gpio::NoPin;
-
 /// Moves the stand-in pins out of `$p` (esp-hal `Peripherals`).
 macro_rules! take_pins {
     ($p:ident) => {

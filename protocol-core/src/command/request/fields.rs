@@ -13,7 +13,15 @@ use super::super::types::{
     ServoId, ServoSelect,
 };
 use super::super::wire::Reader;
-use super::{MAX_DRAG_SPEED, MAX_ENCODER, MIN_SERVO_ADDRESS};
+
+/// Highest encoder value a client may send (pymycobot allows 0..=4096).
+pub const MAX_ENCODER: i16 = 4096;
+/// Highest per-servo drag speed of 0x3E, steps per second (pymycobot: 0..=6000).
+pub const MAX_DRAG_SPEED: i16 = 6000;
+/// Servo registers below this address (firmware version, model) are refused by set servo data
+/// (0x52), as pymycobot does. Reading them is allowed (pymycobot's `is_torque_gripper` reads
+/// register 1 of servo 7).
+pub const MIN_SERVO_ADDRESS: u8 = 5;
 
 /// Reads a frame's fields; a read past the end is `short` (the frame's
 /// [`CommandError::BadLength`]), a value the protocol does not allow its own error.
