@@ -144,17 +144,20 @@ fn pymycobot_end_to_end_suite() {
     assert!(!link_left, "the pty symlink was not removed on exit");
 }
 
-/// Collision protection with pymycobot against a robot with an obstacle in joint 2's way at
-/// 30 degrees (tests/e2e/obstacle_suite.py); the robot announces the obstacle and prints the
-/// collisions it detects.
+/// Collision protection with pymycobot against a robot with obstacles in joint 2's way at 30
+/// degrees and joint 3's at -40 (tests/e2e/obstacle_suite.py); the robot announces the
+/// obstacles and prints the collisions it detects.
 #[test]
 fn pymycobot_against_an_obstacle() {
     let python = python();
-    let mut robot = Robot::start(&["--obstacle", "2:30"]);
-    assert_eq!(
-        robot.launched.banner_value("obstacle: "),
-        Some("joint 2 at 30.00 deg")
-    );
+    let mut robot = Robot::start(&["--obstacle", "2:30", "--obstacle", "3:-40"]);
+    let obstacles: Vec<&str> = robot
+        .launched
+        .banner
+        .lines()
+        .filter_map(|line| line.strip_prefix("obstacle: "))
+        .collect();
+    assert_eq!(obstacles, ["joint 2 at 30.00 deg", "joint 3 at -40.00 deg"]);
     let (passed, output) = run_suite(&python, &robot, "obstacle_*.py");
     robot.launched.stop_with(Signal::SIGTERM);
     let printed = robot.launched.printed_after_ready();

@@ -1,5 +1,6 @@
-"""Collision protection with the real client, against a robot started with an obstacle in joint
-2's way at 30 degrees (`--obstacle 2:30`; tests/pymycobot.rs starts it). pymycobot 4.0.7's
+"""Collision protection with the real client, against a robot started with obstacles in joint
+2's way at 30 degrees and joint 3's at -40 (`--obstacle 2:30 --obstacle 3:-40`;
+tests/pymycobot.rs starts it). pymycobot 4.0.7's
 MyCobot280 has no collision methods: the settings go as raw frames (docs/protocol.md section
 7), everything else through MyCobot280's own methods."""
 
@@ -42,9 +43,20 @@ class ObstacleTest(RobotTestCase):
         self.move_to_angles([0, -10, 0, 0, 0, 0], speed=50)
         self.assertEqual(self.mc.get_error_information(), 0, "moving away raises nothing")
 
+    def test_a_line_into_an_obstacle_is_a_cartesian_collision(self):
+        self.move_to_angles([0, -20, -30, -10, 0, 0], speed=80)
+        through = self.mc.angles_to_coords([0, 80, -30, -10, 0, 0])
+        self.assertEqual(self.mc.send_coords(through, 50, 1), 1, "the line is accepted")
+        angles = self.wait_stopped()
+        self.assertEqual(self.mc.get_error_information(), 17, "collision in a line")
+        self.assertAlmostEqual(angles[2], -40.0, delta=1.0, msg=f"joint 3 stopped at its obstacle: {angles}")
+        self.assertEqual(self.mc.clear_error_information(), 1)
+        self.move_to_angles([0, 0, 0, 0, 0, 0], speed=50)
+
     def test_power_on_also_ends_the_refusal(self):
         self.move_into_the_obstacle()
         self.assertEqual(self.mc.power_on(), 1)
+        self.assertEqual(self.mc.get_error_information(), 0, "and clears the code")
         self.move_to_angles([0, 0, 0, 0, 0, 0], speed=50)
 
     def test_with_protection_off_the_arm_presses_on_as_before(self):
