@@ -130,12 +130,18 @@ impl CollisionSettings {
     }
 
     /// Makes `changed` these settings, kept in `store` first so they survive a restart (a board
-    /// without a store keeps them until it restarts). A flash that fails changes nothing.
+    /// without a store keeps them until it restarts); settings that do not change are not
+    /// written again. A flash that fails changes nothing.
     pub fn replace_kept(
         &mut self,
         changed: Self,
         store: Option<&mut dyn ParamStore>,
     ) -> Result<(), StoreError> {
+        if changed == *self {
+            // Nothing to keep: a script that sets the same mode on every run wears no flash
+            // and stalls nothing.
+            return Ok(());
+        }
         if let Some(store) = store {
             changed.save(store)?;
         }
@@ -477,5 +483,26 @@ mod tests {
         assert_eq!(CollisionSettings::load(&mut store), Some(settings));
         store.store(COLLISION_SETTINGS_KEY, &[7, 7]).unwrap();
         assert_eq!(CollisionSettings::load(&mut store), None);
+    }
+
+    #[test]
+    fn a_change_is_kept_and_the_same_settings_are_not_written_again() {
+        let mut store = crate::store::test_support::Memory::default();
+        let mut settings = CollisionSettings::new(true);
+        settings.replace_kept(settings, Some(&mut store)).unwrap();
+        assert_eq!(CollisionSettings::load(&mut store), None, "nothing written");
+        let off = CollisionSettings::new(false);
+        settings.replace_kept(off, Some(&mut store)).unwrap();
+        assert_eq!(
+            (settings, CollisionSettings::load(&mut store)),
+            (off, Some(off))
+        );
+        settings
+            .replace_kept(CollisionSettings::new(true), None)
+            .unwrap();
+        assert!(
+            settings.enabled(),
+            "a board without a store keeps it until it restarts"
+        );
     }
 }
