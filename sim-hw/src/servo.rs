@@ -764,8 +764,10 @@ impl SimServo {
         } else {
             1
         };
-        // The servo moves while its profile runs, even if something holds the shaft.
-        let profile_running = self.setpoint_velocity != 0.0;
+        // The servo moves while its profile runs, even if something holds the shaft (without
+        // contact the shaft's speed says it).
+        let held = self.setpoint_steps != self.raw_position_steps;
+        let profile_running = held && self.setpoint_velocity != 0.0;
         let moving = torque && (speed != 0 || profile_running || goal.abs_diff(present) > 1);
         let mut status = 0;
         if stalled || (self.overload_tripped && torque) {
