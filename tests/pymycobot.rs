@@ -30,12 +30,16 @@ struct Robot {
 }
 
 impl Robot {
-    /// The robot, with `extra` arguments on its command line.
-    fn start(extra: &[&str]) -> Robot {
-        let link = std::env::temp_dir().join(format!("open-mycobot-e2e-{}", std::process::id()));
+    /// A robot of its own named `name` (its pty link and flash file carry the name, so the
+    /// tests of this file, which run at the same time, each talk to their own), with `extra`
+    /// arguments on its command line.
+    fn start(name: &str, extra: &[&str]) -> Robot {
+        let link =
+            std::env::temp_dir().join(format!("open-mycobot-e2e-{}-{name}", std::process::id()));
         let link_arg = link.to_str().expect("temp dir path is UTF-8");
         // The Basic's flash (Wi-Fi settings the suite changes) in a scratch file, erased.
-        let flash = Path::new(env!("CARGO_TARGET_TMPDIR")).join("e2e-basic-flash.bin");
+        let flash =
+            Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("e2e-basic-flash-{name}.bin"));
         let _ = fs::remove_file(&flash);
         let flash_arg = flash.to_str().expect("target dir path is UTF-8");
         // The view on too (nobody watches it): the suite runs with the simulation publishing.
@@ -124,7 +128,7 @@ fn run_suite(python: &Path, robot: &Robot, pattern: &str) -> (bool, String) {
 #[test]
 fn pymycobot_end_to_end_suite() {
     let python = python();
-    let mut robot = Robot::start(&[]);
+    let mut robot = Robot::start("suite", &[]);
     assert!(
         fs::read_link(&robot.link).is_ok(),
         "--pty-link did not create {}",
@@ -150,7 +154,7 @@ fn pymycobot_end_to_end_suite() {
 #[test]
 fn pymycobot_against_an_obstacle() {
     let python = python();
-    let mut robot = Robot::start(&["--obstacle", "2:30", "--obstacle", "3:-40"]);
+    let mut robot = Robot::start("obstacle", &["--obstacle", "2:30", "--obstacle", "3:-40"]);
     let obstacles: Vec<&str> = robot
         .launched
         .banner
