@@ -193,6 +193,14 @@ impl FrameDecoder {
         self.next_frame()
     }
 
+    /// Drops a candidate made only of the last `n` bytes received (they were something else:
+    /// a servo packet's checksum or data that looked like the start of a frame).
+    pub(crate) fn drop_partial_within(&mut self, n: usize) {
+        if self.scanner.len() <= n {
+            self.scanner.clear();
+        }
+    }
+
     /// True while the decoder holds the start of a frame that is not complete yet.
     pub fn has_partial(&self) -> bool {
         self.scanner.has_partial()

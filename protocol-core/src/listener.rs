@@ -429,6 +429,8 @@ impl Listener {
         if self.config.packets {
             let mut next = self.packets.push(byte);
             while let Some(packet) = next {
+                // A valid servo packet's bytes are not the start of a host frame.
+                self.frames.drop_partial_within(packet.encoded_len());
                 on_heard(Heard::Packet(packet));
                 next = self.packets.next_packet();
             }
@@ -473,6 +475,23 @@ mod tests {
                 _ => None,
             })
             .collect()
+    }
+
+    #[test]
+    fn a_servo_reply_ending_in_fe_leaves_no_frame_in_progress() {
+        // One reply in 256 has the checksum FE, the first byte of a host frame: the station
+        // must not wait for the frame gap before its next transaction.
+        let reply = (0..=255u8)
+            .map(|load| status(1, &[0x00, 0x08, load, 0x00]))
+            .find(|p| p.to_bytes().last() == Some(&0xFE))
+            .unwrap();
+        let mut rx = Listener::default();
+        assert_eq!(run(&mut rx, 0, &reply.to_bytes()), [Heard::Packet(reply)]);
+        assert!(!rx.frame_in_progress());
+        // A host frame right after it is still heard whole.
+        let request = frame(0x20, &[]);
+        let heard = run(&mut rx, 200, &request.to_bytes());
+        assert_eq!(heard_frames(&heard), [request]);
     }
 
     #[test]

@@ -137,6 +137,17 @@ impl<const N: usize> Scanner<N> {
         !self.buf.is_empty()
     }
 
+    /// Bytes held (a candidate in progress).
+    pub(crate) fn len(&self) -> usize {
+        self.buf.len()
+    }
+
+    /// Forgets the candidate in progress.
+    pub(crate) fn clear(&mut self) {
+        self.buf.clear();
+        self.stale = 0;
+    }
+
     /// Bytes dropped outside packets or at the start of rejected candidates. Wraps.
     pub(crate) fn skipped(&self) -> u32 {
         self.skipped
