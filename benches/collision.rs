@@ -194,15 +194,8 @@ fn stream_detection(threshold: u8) -> Result<f64, &'static str> {
     });
     contact_to_detection(&mut robot, 2, |robot, t_us| {
         if t_us % 20_000 == 0 {
-            let angle = Centideg(((t_us / 20_000 + 1) * 60).min(6_000) as i16);
-            let angles = [
-                Centideg(0),
-                angle,
-                Centideg(0),
-                Centideg(0),
-                Centideg(0),
-                Centideg(0),
-            ];
+            let angle = ((t_us / 20_000 + 1) * 60).min(6_000) as i16;
+            let angles = [0, angle, 0, 0, 0, 0].map(Centideg);
             let sample = Request::SendAngles {
                 angles,
                 speed: speed(100),
@@ -359,17 +352,11 @@ fn corpus(threshold: u8) -> (usize, usize) {
         let angles = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0].map(|phase| {
             Centideg((3_000.0 * (std::f64::consts::TAU * 0.4 * t + phase).sin()) as i16)
         });
-        robot.host_write(
-            &Request::SendAngles {
-                angles,
-                speed: speed(100),
-            }
-            .to_frame()
-            .to_bytes(),
-        );
-        robot.run_for(20_000);
-        let mut replies = Vec::new();
-        robot.host_read(&mut replies);
+        let sample = Request::SendAngles {
+            angles,
+            speed: speed(100),
+        };
+        robot.stream_sample(&sample, 20_000);
     }
     wait_until_still(&mut robot, 5_000_000);
     motions += 1;

@@ -197,17 +197,11 @@ fn a_stream_into_an_obstacle_is_stopped_while_it_streams() {
     // A ROS-like 50 Hz stream ramping joint 2 to 60 deg over 2 s.
     for k in 1..=100i16 {
         let angles = [0, k * 60, 0, 0, 0, 0].map(Centideg);
-        robot.host_write(
-            &Request::SendAngles {
-                angles,
-                speed: speed(100),
-            }
-            .to_frame()
-            .to_bytes(),
-        );
-        robot.run_for(20_000);
-        let mut replies = Vec::new();
-        robot.host_read(&mut replies);
+        let sample = Request::SendAngles {
+            angles,
+            speed: speed(100),
+        };
+        robot.stream_sample(&sample, 20_000);
         if robot.atom().collision().is_some() {
             break;
         }

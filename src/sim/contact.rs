@@ -6,10 +6,10 @@
 use std::fmt;
 use std::str::FromStr;
 
-use firmware_atom::AtomConfig;
+use firmware_atom::{AtomConfig, JointSign};
 use protocol_core::units::Centideg;
 
-use sim_hw::ServoChain;
+use sim_hw::{ServoChain, SimServo};
 
 /// A rigid stop for joint `joint` (1..=6) at `angle`: the joint cannot move past it from the
 /// side it is on when the stop is placed.
@@ -25,19 +25,42 @@ impl Obstacle {
     /// Puts this stop into its joint's servo among `servos`, whose angles `config` maps onto
     /// encoder steps; `false` if there is no such servo.
     pub fn place(&self, servos: &mut ServoChain, config: &AtomConfig) -> bool {
-        let index = usize::from(self.joint).wrapping_sub(1);
-        let Some(servo) = config
-            .servo_ids
-            .get(index)
-            .filter(|_| index < 6)
-            .and_then(|&id| servos.get_mut(id))
-        else {
+        let Some(servo) = joint_servo(servos, config, self.joint) else {
             return false;
         };
+        let index = usize::from(self.joint - 1);
         let steps = config.angle_to_steps(index, self.angle);
         servo.add_obstacle(steps.0.clamp(0, 4095) as u16);
         true
     }
+}
+
+/// Pushes joint `joint` (1..=6) with an external torque of `permille` thousandths of its
+/// servo's maximum torque, towards higher angles for a positive value (0 lets go): someone
+/// leaning on the arm ([`SimServo::push`]). `false` if there is no such joint.
+pub fn push(servos: &mut ServoChain, config: &AtomConfig, joint: u8, permille: i16) -> bool {
+    let Some(servo) = joint_servo(servos, config, joint) else {
+        return false;
+    };
+    let towards_higher_steps = match config.joint_signs.get(usize::from(joint - 1)) {
+        Some(JointSign::Negative) => permille.saturating_neg(),
+        _ => permille,
+    };
+    servo.push(towards_higher_steps);
+    true
+}
+
+/// The servo of joint `joint` (1..=6) among `servos`, as `config` maps joints onto bus ids.
+fn joint_servo<'a>(
+    servos: &'a mut ServoChain,
+    config: &AtomConfig,
+    joint: u8,
+) -> Option<&'a mut SimServo> {
+    if !(1..=6).contains(&joint) {
+        return None;
+    }
+    let id = *config.servo_ids.get(usize::from(joint - 1))?;
+    servos.get_mut(id)
 }
 
 /// Why an `--obstacle` value was refused.

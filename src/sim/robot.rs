@@ -12,7 +12,7 @@ use protocol_core::units::{Centideg, Steps};
 use protocol_core::{Frame, FrameDecoder};
 
 use super::basic_flash::BasicFlashStore;
-use super::contact::Obstacle;
+use super::contact::{self, Obstacle};
 use super::servo::SimServo;
 use super::wire::{Bus, HeardByte, SerialLine, SerialPort, StationId};
 use sim_hw::ServoChain;
@@ -709,28 +709,19 @@ impl VirtualRobot {
 
     /// Pushes joint `joint` (1..=6) with an external torque of `permille` thousandths of its
     /// servo's maximum torque, towards higher angles for a positive value (0 lets go):
-    /// someone leaning on the arm ([`SimServo::push`]). `false` if there is no such joint.
+    /// someone leaning on the arm ([`contact::push`]). `false` if there is no such joint.
     pub fn push_joint(&mut self, joint: u8, permille: i16) -> bool {
-        if !(1..=6).contains(&joint) {
-            return false;
-        }
-        let config = self.atom.config();
-        let towards_higher_steps = match config.joint_signs.get(usize::from(joint).wrapping_sub(1))
-        {
-            Some(firmware_atom::JointSign::Negative) => permille.saturating_neg(),
-            _ => permille,
-        };
-        let id = config
-            .servo_ids
-            .get(usize::from(joint).wrapping_sub(1))
-            .copied();
-        match id.and_then(|id| self.servos.get_mut(id)) {
-            Some(servo) => {
-                servo.push(towards_higher_steps);
-                true
-            }
-            None => false,
-        }
+        contact::push(&mut self.servos, self.atom.config(), joint, permille)
+    }
+
+    /// Sends `request` as one sample of a stream: writes it on the Basic's USB, runs for the
+    /// stream's period `period_us` and drops the replies, as a client that streams without
+    /// reading them (a ROS node streaming `send_angles`).
+    pub fn stream_sample(&mut self, request: &Request, period_us: u64) {
+        self.host_write(&request.to_frame().to_bytes());
+        self.run_for(period_us);
+        let mut replies = Vec::new();
+        self.host_read(&mut replies);
     }
 
     /// Every simulated servo, in the order they were built (ids 1..7 at power-up).
