@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 use clap::Parser;
-use firmware_atom::collision::{Collision, Kind};
+use firmware_atom::collision::Collision;
 use firmware_basic::wifi::WifiConfig;
 use open_mycobot::host::cli::{Cli, default_basic_flash};
 use open_mycobot::host::emulated::{CONNECT_TIMEOUT, Chardev, EmulatedBoards};
@@ -199,15 +199,11 @@ fn serve_emulated(
 
 /// What the virtual robot prints when the Atom detects a collision.
 fn collision_line(at_ns: u64, collision: &Collision) -> String {
-    let during = match collision.kind {
-        Kind::JointMotion => "moving joints",
-        Kind::CartesianMotion => "moving in a line or arc",
-        Kind::Holding => "holding still",
-    };
     format!(
-        "collision: joint {} while {during}, error {} (load {:.1} %), at {:.3} s; \
+        "collision: joint {} while {}, error {} (load {:.1} %), at {:.3} s; \
          clear_error_information() to move again",
         collision.joint + 1,
+        collision.kind.during(),
         collision.code(),
         f64::from(collision.load_permille) / 10.0,
         at_ns as f64 / 1e9

@@ -195,6 +195,16 @@ pub struct Collision {
 }
 
 impl Kind {
+    /// What the arm was doing, in words: "moving joints", "moving in a line or arc",
+    /// "holding still".
+    pub fn during(self) -> &'static str {
+        match self {
+            Kind::JointMotion => "moving joints",
+            Kind::CartesianMotion => "moving in a line or arc",
+            Kind::Holding => "holding still",
+        }
+    }
+
     /// The error code get error information (0x07) reports: 16 in a joint-space motion, 17 in
     /// a Cartesian motion, 18 when the arm was holding still (19, the last of pymycobot's
     /// collision codes, is not used).

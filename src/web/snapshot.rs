@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 
 use firmware_atom::cartesian::{self, Cartesian};
+use firmware_atom::collision::Kind;
 use kinematics_core::ArmGeometry;
 use kinematics_core::geometry::DH_ALPHA_CENTIDEG;
 use protocol_core::command::{EndType, Pose, ReferenceFrame};
@@ -49,8 +50,8 @@ pub struct Snapshot {
 pub struct CollisionMark {
     /// The joint that pressed, 1..=6.
     pub joint: u8,
-    /// The error code 0x07 reports (16..=18).
-    pub code: u8,
+    /// What the arm was doing; it chooses the error code 0x07 reports (16..=18).
+    pub kind: Kind,
     /// When it was detected, virtual time in microseconds.
     pub time_us: u64,
 }
@@ -83,7 +84,7 @@ impl Snapshot {
                 let &(at_ns, logged) = robot.collisions().last()?;
                 (logged == latched).then(|| CollisionMark {
                     joint: u8::try_from(latched.joint + 1).unwrap_or(u8::MAX),
-                    code: latched.code(),
+                    kind: latched.kind,
                     time_us: at_ns / 1_000,
                 })
             }),
@@ -102,7 +103,8 @@ impl Snapshot {
     /// {"t_s":1.5,"angles_deg":[10,20,-30,15,-25,40],
     ///  "coords":[x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg],"end":"flange","frame":"base",
     ///  "tool":null,"gripper":50,"led":[255,0,0],"powered":true,"moving":false,
-    ///  "collision":{"joint":2,"code":16,"t_s":3.25},"late_ms":0,"late_stalls":0}
+    ///  "collision":{"joint":2,"code":16,"during":"moving joints","t_s":3.25},
+    ///  "late_ms":0,"late_stalls":0}
     /// ```
     ///
     /// `collision`: the collision not cleared yet ([`CollisionMark`]), or `null`.
@@ -139,9 +141,10 @@ impl Snapshot {
             Some(c) => {
                 let _ = write!(
                     out,
-                    "{{\"joint\":{},\"code\":{},\"t_s\":{}}}",
+                    "{{\"joint\":{},\"code\":{},\"during\":\"{}\",\"t_s\":{}}}",
                     c.joint,
-                    c.code,
+                    c.kind.code(),
+                    c.kind.during(),
                     c.time_us as f64 / 1e6
                 );
             }
@@ -269,7 +272,7 @@ mod tests {
             moving: false,
             collision: Some(CollisionMark {
                 joint: 2,
-                code: 16,
+                kind: Kind::JointMotion,
                 time_us: 3_250_000,
             }),
             late: Lateness {
@@ -291,7 +294,7 @@ mod tests {
                 "led": [255.0, 0.0, 16.0],
                 "powered": true,
                 "moving": false,
-                "collision": {"joint": 2.0, "code": 16.0, "t_s": 3.25},
+                "collision": {"joint": 2.0, "code": 16.0, "during": "moving joints", "t_s": 3.25},
                 "late_ms": 1.25,
                 "late_stalls": 2.0,
             }))
@@ -334,7 +337,7 @@ mod tests {
         robot.push_joint(3, 900);
         robot.run_for(100_000);
         let mark = Snapshot::of(&robot).collision.expect("marked");
-        assert_eq!((mark.joint, mark.code), (3, 18));
+        assert_eq!((mark.joint, mark.kind.code()), (3, 18));
         assert!((1_500_000..1_600_000).contains(&mark.time_us), "{mark:?}");
         robot.push_joint(3, 0);
         let clear = protocol_core::command::Request::ClearErrorInfo;

@@ -38,18 +38,14 @@ function showReadout(state) {
   showCollision(state.collision);
 }
 
-// What the Atom's error codes 16..18 mean (docs/protocol.md section 7).
-const COLLISION_DURING = { 16: 'moving joints', 17: 'moving in a line or arc', 18: 'holding still' };
-
 // The collision the Atom detected and the host has not cleared: its joint's row marked, and a
 // line saying which joint, what error and when.
 function showCollision(collision) {
   jointCells.forEach((cell, j) => cell.parentElement.classList.toggle('hit', collision?.joint === j + 1));
   $('collision').hidden = !collision;
   if (collision) {
-    const during = COLLISION_DURING[collision.code] ?? 'collision';
     $('collision').textContent =
-      `collision: J${collision.joint} (error ${collision.code}, ${during}) at ${collision.t_s.toFixed(2)} s; clear_error_information() to move again`;
+      `collision: J${collision.joint} (error ${collision.code}, ${collision.during}) at ${collision.t_s.toFixed(2)} s; clear_error_information() to move again`;
   }
 }
 
