@@ -61,7 +61,7 @@ fn stream() -> impl Strategy<Value = Vec<u8>> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 128, failure_persistence: None, ..ProptestConfig::default() })]
 
     /// Any bytes on either side, any timing, any transmitter state: the Basic never panics,
     /// and afterwards it still answers: "set framed mode" then "get Basic version" get their

@@ -25,6 +25,8 @@ pub const MIN_LEN: u8 = 2;
 pub const MAX_DATA: usize = MAX_LEN as usize - 2;
 /// Most bytes one encoded frame occupies on the wire (`FE FE LEN` + LEN).
 pub const MAX_FRAME_BYTES: usize = 3 + MAX_LEN as usize;
+/// Shortest possible frame on the wire: `FE FE 02 CMD FA`, no data.
+pub const MIN_FRAME_BYTES: usize = 3 + MIN_LEN as usize;
 /// Largest reply data pymycobot accepts (it rejects LEN > 30).
 pub const MAX_REPLY_DATA: usize = 28;
 
@@ -193,12 +195,15 @@ impl FrameDecoder {
         self.next_frame()
     }
 
-    /// Drops a candidate made only of the last `n` bytes received (they were something else:
-    /// a servo packet's checksum or data that looked like the start of a frame).
-    pub(crate) fn drop_partial_within(&mut self, n: usize) {
-        if self.scanner.len() <= n {
-            self.scanner.clear();
-        }
+    /// Bytes held: the candidate in progress and whatever was received after its start.
+    pub(crate) fn held(&self) -> usize {
+        self.scanner.len()
+    }
+
+    /// Forgets the first `n` bytes held (they were something else, a servo packet's data or
+    /// checksum that looked like the start of a frame); the rest is scanned again.
+    pub(crate) fn discard(&mut self, n: usize) {
+        self.scanner.discard(n);
     }
 
     /// True while the decoder holds the start of a frame that is not complete yet.

@@ -22,12 +22,21 @@
 //!   transmission gets one [`Echo`] verdict, which is what the Basic decides retransmissions
 //!   on, and a collision on a line known to echo is also kept for [`Listener::take_collision`].
 //!
+//! * **Where a byte belongs.** The listener counts the bytes it decodes, so it knows where every
+//!   frame, packet and candidate lies in the stream. A host frame that completes inside a
+//!   servo packet still arriving (its header and LEN already heard, its end not yet) is held
+//!   until that packet resolves: a valid packet around it means it was the servo's data and it
+//!   is dropped; a packet that fails its checksum or is cut short releases it, in order. A
+//!   frame candidate that started inside a valid packet is dropped up to the packet's end, and
+//!   only that: a frame starting after the packet is kept, however late the packet was found
+//!   (a false packet candidate before it can delay the real packet by its whole length).
+//!
 //! Zero allocation, bounded buffers, never panics on any input or any timing (time may even
 //! go backwards: every difference saturates).
 
 use heapless::Vec;
 
-use crate::frame::{Frame, FrameDecoder, MAX_FRAME_BYTES};
+use crate::frame::{Frame, FrameDecoder, MAX_FRAME_BYTES, MIN_FRAME_BYTES};
 use crate::servo::{MAX_PACKET_BYTES, Packet, PacketDecoder};
 use crate::timing::{BUS_BAUD, BUS_FRAME_GAP_US, BUS_PACKET_GAP_US, ECHO_GRACE_US, wire_time_us};
 
@@ -38,6 +47,19 @@ pub const ECHO_CAPACITY: usize = if MAX_PACKET_BYTES > MAX_FRAME_BYTES {
 } else {
     MAX_FRAME_BYTES
 };
+
+/// Most host frames that can lie inside one servo packet, each held until the packet resolves.
+const HELD_FRAMES: usize = MAX_PACKET_BYTES / MIN_FRAME_BYTES;
+
+/// A complete host frame that may be a servo packet's data, and where it lies in the stream.
+#[derive(Clone, Debug)]
+struct HeldFrame {
+    /// Stream position of its first byte.
+    start: u64,
+    /// Stream position after its last byte.
+    end: u64,
+    frame: Frame,
+}
 
 /// Whether a station hears its own transmissions (TX and RX tied on the wire). The wiring of
 /// the myCobot's boards is not documented, so the default finds out.
@@ -192,6 +214,12 @@ pub struct Listener {
     collided: bool,
     /// Received bytes dropped as own echo. Wraps.
     echo_bytes: u32,
+    /// Bytes the frame decoder and the packet decoder have taken so far: the stream position
+    /// after the last byte each has seen (they differ while a byte is between them).
+    frames_fed: u64,
+    packets_fed: u64,
+    /// Complete frames inside a servo packet candidate, in stream order, until it resolves.
+    held: Vec<HeldFrame, HELD_FRAMES>,
 }
 
 impl Default for Listener {
@@ -214,6 +242,9 @@ impl Listener {
             echo_heard: None,
             collided: false,
             echo_bytes: 0,
+            frames_fed: 0,
+            packets_fed: 0,
+            held: Vec::new(),
         }
     }
 
@@ -241,6 +272,7 @@ impl Listener {
     /// Takes one byte received at `now_us`; calls `on_heard` with everything it completes or
     /// releases, in order.
     pub fn push(&mut self, now_us: u64, byte: u8, on_heard: &mut impl FnMut(Heard)) {
+        self.release_uncovered(on_heard);
         self.last_activity_us = self.last_activity_us.max(now_us);
         if self.window.is_some() {
             if self.config.echo != EchoMode::Absent && self.sent.get(self.echoed) == Some(&byte) {
@@ -273,6 +305,9 @@ impl Listener {
         if self.frames.has_partial() || self.packets.has_partial() {
             self.cut_short(now_us, on_heard);
         }
+        if !self.held.is_empty() {
+            self.release_uncovered(on_heard);
+        }
     }
 
     /// Forgets every frame and packet in progress, and whatever complete one a rescan would
@@ -301,9 +336,10 @@ impl Listener {
         core::mem::take(&mut self.collided)
     }
 
-    /// True while a host frame is arriving (its start heard, its end not yet).
+    /// True while a host frame is arriving (its start heard, its end not yet), or a complete
+    /// one waits for the servo packet around it to resolve.
     pub fn frame_in_progress(&self) -> bool {
-        self.frames.has_partial()
+        self.frames.has_partial() || !self.held.is_empty()
     }
 
     /// True while part of the open transmission's echo has come back: the line echoes, even if
@@ -383,18 +419,12 @@ impl Listener {
             && quiet_us >= self.config.packet_gap_us
             && self.packets.has_partial()
         {
-            let mut next = self.packets.on_quiet_line();
-            while let Some(packet) = next {
-                on_heard(Heard::Packet(packet));
-                next = self.packets.next_packet();
-            }
+            let next = self.packets.on_quiet_line();
+            self.found_packets(next, on_heard);
         }
         if self.config.frames && quiet_us >= self.config.frame_gap_us && self.frames.has_partial() {
-            let mut next = self.frames.on_quiet_line();
-            while let Some(frame) = next {
-                on_heard(Heard::Frame(frame));
-                next = self.frames.next_frame();
-            }
+            let next = self.frames.on_quiet_line();
+            self.found_frames(next, on_heard);
         }
     }
 
@@ -414,26 +444,120 @@ impl Listener {
         }
     }
 
-    /// Passes a byte that is not own echo to the decoders that are on.
+    /// Passes a byte that is not own echo to the decoders that are on: the frame decoder
+    /// first, so that a packet ending on the same byte finds the frame it contains.
     fn decode(&mut self, byte: u8, on_heard: &mut impl FnMut(Heard)) {
         if self.config.bytes {
             on_heard(Heard::Byte(byte));
         }
         if self.config.frames {
-            let mut next = self.frames.push(byte);
-            while let Some(frame) = next {
-                on_heard(Heard::Frame(frame));
-                next = self.frames.next_frame();
-            }
+            self.frames_fed = self.frames_fed.wrapping_add(1);
+            let next = self.frames.push(byte);
+            self.found_frames(next, on_heard);
         }
         if self.config.packets {
-            let mut next = self.packets.push(byte);
-            while let Some(packet) = next {
-                // A valid servo packet's bytes are not the start of a host frame.
-                self.frames.drop_partial_within(packet.encoded_len());
-                on_heard(Heard::Packet(packet));
-                next = self.packets.next_packet();
+            self.packets_fed = self.packets_fed.wrapping_add(1);
+            let next = self.packets.push(byte);
+            self.found_packets(next, on_heard);
+        }
+        self.release_uncovered(on_heard);
+    }
+
+    /// Stream position of the first byte the packet decoder holds.
+    fn packets_front(&self) -> u64 {
+        self.packets_fed.wrapping_sub(self.packets.held() as u64)
+    }
+
+    /// Stream position of the first byte the frame decoder holds.
+    fn frames_front(&self) -> u64 {
+        self.frames_fed.wrapping_sub(self.frames.held() as u64)
+    }
+
+    /// Gives out `first` and the packets after it; each one's bytes are no host frame.
+    fn found_packets(&mut self, first: Option<Packet>, on_heard: &mut impl FnMut(Heard)) {
+        let mut next = first;
+        while let Some(packet) = next {
+            let end = self.packets_front();
+            let start = end.wrapping_sub(packet.encoded_len() as u64);
+            // Frames held inside it were its data; those before it come out first.
+            while let Some(first) = self.held.first() {
+                if first.start >= start && first.end <= end {
+                    self.held.remove(0);
+                } else if first.start < start {
+                    self.release_first(on_heard);
+                } else {
+                    break;
+                }
             }
+            // A frame candidate starting inside the packet is dropped up to the packet's end.
+            let frame_front = self.frames_front();
+            if self.config.frames && frame_front >= start && frame_front < end {
+                // end - frame_front <= a packet's length.
+                self.frames.discard((end - frame_front) as usize);
+                let next = self.frames.next_frame();
+                self.found_frames(next, on_heard);
+            }
+            on_heard(Heard::Packet(packet));
+            next = self.packets.next_packet();
+        }
+    }
+
+    /// Gives out `first` and the frames after it, or holds each one that a servo packet
+    /// candidate still arriving may contain.
+    fn found_frames(&mut self, first: Option<Frame>, on_heard: &mut impl FnMut(Heard)) {
+        let mut next = first;
+        while let Some(frame) = next {
+            let end = self.frames_front();
+            let start = end.wrapping_sub(frame.encoded_len() as u64);
+            let held = HeldFrame { start, end, frame };
+            if self.packet_may_contain(&held) || !self.held.is_empty() {
+                if let Err(held) = self.held.push(held) {
+                    // Cannot happen (a packet holds at most HELD_FRAMES frames); never lose
+                    // one: the oldest comes out.
+                    self.release_first(on_heard);
+                    let _ = self.held.push(held);
+                }
+            } else {
+                self.give_frame(held, on_heard);
+            }
+            next = self.frames.next_frame();
+        }
+    }
+
+    /// Gives out the held frames that no servo packet candidate may contain any more, in order.
+    fn release_uncovered(&mut self, on_heard: &mut impl FnMut(Heard)) {
+        while let Some(first) = self.held.first() {
+            if self.packet_may_contain(first) {
+                return;
+            }
+            self.release_first(on_heard);
+        }
+    }
+
+    /// True if the servo packet candidate in progress started before `frame`: the frame may
+    /// be that packet's data.
+    fn packet_may_contain(&self, frame: &HeldFrame) -> bool {
+        self.packets.has_partial() && self.packets_front() < frame.start
+    }
+
+    /// Gives out the oldest held frame.
+    fn release_first(&mut self, on_heard: &mut impl FnMut(Heard)) {
+        if !self.held.is_empty() {
+            let held = self.held.remove(0);
+            self.give_frame(held, on_heard);
+        }
+    }
+
+    /// Gives out a frame that is no servo packet's data. A packet candidate that started
+    /// inside it was the frame's data, not a packet: dropped up to the frame's end.
+    fn give_frame(&mut self, frame: HeldFrame, on_heard: &mut impl FnMut(Heard)) {
+        on_heard(Heard::Frame(frame.frame));
+        let front = self.packets_front();
+        if self.packets.has_partial() && front > frame.start && front < frame.end {
+            // frame.end - front < a frame's length.
+            self.packets.discard((frame.end - front) as usize);
+            let next = self.packets.next_packet();
+            self.found_packets(next, on_heard);
         }
     }
 }
@@ -491,6 +615,67 @@ mod tests {
         // A host frame right after it is still heard whole.
         let request = frame(0x20, &[]);
         let heard = run(&mut rx, 200, &request.to_bytes());
+        assert_eq!(heard_frames(&heard), [request]);
+    }
+
+    #[test]
+    fn a_frame_after_a_late_found_packet_is_kept() {
+        // The shrunk case of `own_echo_never_comes_out_on_a_line_that_echoes`: a host frame
+        // whose data looks like the start of a servo packet (FF FF 00 LEN), a real packet, then
+        // a host frame. The false candidate holds the real packet back until its checksum
+        // fails, so the packet is found while the last frame is already arriving: that frame
+        // started after the packet and must come out.
+        let first = frame(0x20, &[0xFF, 0xFF, 0x00, 0x0A]);
+        let reply = status(1, &[0x00, 0x08]);
+        let last = frame(0x2B, &[]);
+        let mut rx = Listener::default();
+        let mut heard = run(&mut rx, 0, &first.to_bytes());
+        heard.extend(run(&mut rx, 500, &reply.to_bytes()));
+        heard.extend(run(&mut rx, 1_000, &last.to_bytes()));
+        assert_eq!(heard_frames(&heard), [first, last], "{heard:?}");
+        assert!(heard.contains(&Heard::Packet(reply)));
+        assert!(!rx.frame_in_progress());
+    }
+
+    #[test]
+    fn a_host_frame_inside_a_servo_reply_is_not_a_request() {
+        // A servo's answer to a long read whose data happens to hold a whole host frame.
+        let fake = frame(0x29, &[]).to_bytes();
+        let mut data = [0x11u8; 12];
+        data[3..3 + fake.len()].copy_from_slice(&fake);
+        let reply = status(3, &data);
+        let mut rx = Listener::default();
+        let heard = run(&mut rx, 0, &reply.to_bytes());
+        assert_eq!(heard, [Heard::Packet(reply)]);
+        assert!(!rx.frame_in_progress());
+        // Ending on the packet's last byte too.
+        let mut data = [0x11u8; 8];
+        let tail = frame(0x29, &[]).to_bytes();
+        data[8 - 4..].copy_from_slice(&tail[..4]);
+        let packet = status(3, &data).to_bytes();
+        assert!(heard_frames(&run(&mut rx, 500, &packet)).is_empty());
+    }
+
+    #[test]
+    fn a_host_frame_after_a_false_packet_start_comes_out_once_the_packet_fails() {
+        // FF FF 01 10 promises 16 more bytes; a host frame arrives inside them. It is held
+        // until the false packet's checksum fails, then comes out.
+        let request = frame(0x20, &[]);
+        let mut bytes = std::vec![0xFF, 0xFF, 0x01, 0x10];
+        bytes.extend_from_slice(&request.to_bytes());
+        let mut rx = Listener::default();
+        let heard = run(&mut rx, 0, &bytes);
+        assert!(
+            heard_frames(&heard).is_empty(),
+            "held while it may be packet data"
+        );
+        assert!(rx.frame_in_progress());
+        let heard = run(&mut rx, 200, &[0u8; 12]);
+        assert_eq!(heard_frames(&heard), std::slice::from_ref(&request));
+        // Or once the line goes quiet and the packet is cut short.
+        let mut rx = Listener::default();
+        run(&mut rx, 0, &bytes);
+        let heard = tick(&mut rx, 90 + BUS_FRAME_GAP_US + BUS_PACKET_GAP_US);
         assert_eq!(heard_frames(&heard), [request]);
     }
 

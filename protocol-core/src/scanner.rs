@@ -142,10 +142,13 @@ impl<const N: usize> Scanner<N> {
         self.buf.len()
     }
 
-    /// Forgets the candidate in progress.
-    pub(crate) fn clear(&mut self) {
-        self.buf.clear();
-        self.stale = 0;
+    /// Forgets the first `n` bytes held (all of them if fewer); a candidate starting after them
+    /// is scanned as usual.
+    pub(crate) fn discard(&mut self, n: usize) {
+        let n = n.min(self.buf.len());
+        // n <= N, a buffer size; a wrap of the statistics counter is harmless.
+        self.skipped = self.skipped.wrapping_add(n as u32);
+        self.remove_front(n);
     }
 
     /// Bytes dropped outside packets or at the start of rejected candidates. Wraps.
@@ -160,11 +163,16 @@ impl<const N: usize> Scanner<N> {
 
     /// Removes the first `n` bytes of the buffer; a single dropped byte counts as skipped.
     fn drop_front(&mut self, n: usize) {
-        let n = n.min(self.buf.len());
-        self.stale = self.stale.saturating_sub(n);
-        if n == 1 {
+        if n == 1 && !self.buf.is_empty() {
             self.skipped = self.skipped.wrapping_add(1);
         }
+        self.remove_front(n);
+    }
+
+    /// Removes the first `n` bytes of the buffer (all of them if fewer).
+    fn remove_front(&mut self, n: usize) {
+        let n = n.min(self.buf.len());
+        self.stale = self.stale.saturating_sub(n);
         let len = self.buf.len();
         self.buf.copy_within(n..len, 0);
         self.buf.truncate(len - n);

@@ -587,6 +587,17 @@ impl PacketDecoder {
         self.scanner.has_partial()
     }
 
+    /// Bytes held: the candidate in progress and whatever was received after its start.
+    pub(crate) fn held(&self) -> usize {
+        self.scanner.len()
+    }
+
+    /// Forgets the first `n` bytes held (they were a host frame's data that looked like the
+    /// start of a packet); the rest is scanned again.
+    pub(crate) fn discard(&mut self, n: usize) {
+        self.scanner.discard(n);
+    }
+
     /// Number of candidates dropped for a wrong checksum (corrupted replies). Wraps.
     pub fn checksum_errors(&self) -> u32 {
         self.scanner.bad_checksums()
