@@ -95,7 +95,11 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
         }
         None => {}
     }
-    let mut robot = VirtualRobot::new(RobotConfig::default()).with_basic_flash(flash);
+    let config = RobotConfig {
+        flash_timing: cli.flash_timing,
+        ..RobotConfig::default()
+    };
+    let mut robot = VirtualRobot::new(config).with_basic_flash(flash);
     for &obstacle in &cli.obstacles {
         robot.add_obstacle(obstacle);
         writeln!(out, "obstacle: {obstacle}")?;

@@ -20,7 +20,7 @@ use embedded_storage::nor_flash::{NorFlash, ReadNorFlash};
 use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapStorage};
 
-pub use mem::MemFlash;
+pub use mem::{MemFlash, PROGRAM_PAGE};
 
 /// Longest value the store takes, bytes (with its key, the work buffer's size).
 pub const MAX_VALUE: usize = 120;

@@ -8,11 +8,15 @@ use embedded_storage::nor_flash::{
 /// Erase page size, bytes (the ESP32's flash sector).
 const PAGE: usize = 4096;
 
+/// Program page size, bytes: a NOR flash programs at most one such page per operation.
+pub const PROGRAM_PAGE: usize = 256;
+
 /// `SIZE` bytes of NOR flash in RAM. See the [module doc](self).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct MemFlash<const SIZE: usize> {
     bytes: [u8; SIZE],
     erases: [u32; 64],
+    programs: u32,
     fail_writes: bool,
 }
 
@@ -49,6 +53,7 @@ impl<const SIZE: usize> MemFlash<SIZE> {
         Self {
             bytes: [0xFF; SIZE],
             erases: [0; 64],
+            programs: 0,
             fail_writes: false,
         }
     }
@@ -76,6 +81,12 @@ impl<const SIZE: usize> MemFlash<SIZE> {
     /// How often each page was erased.
     pub fn erase_counts(&self) -> &[u32] {
         self.erases.get(..SIZE / PAGE).unwrap_or(&[])
+    }
+
+    /// Page programs so far: a write takes one per [`PROGRAM_PAGE`]-byte page it touches (the
+    /// time a chip spends on a write goes by these). Wraps.
+    pub fn program_count(&self) -> u32 {
+        self.programs
     }
 
     fn span(&self, offset: u32, len: usize) -> Result<core::ops::Range<usize>, MemFlashError> {
@@ -142,6 +153,11 @@ impl<const SIZE: usize> NorFlash for MemFlash<SIZE> {
             return Err(MemFlashError::NotAligned);
         }
         let span = self.span(offset, bytes.len())?;
+        if !span.is_empty() {
+            let pages = (span.end - 1) / PROGRAM_PAGE - span.start / PROGRAM_PAGE + 1;
+            // pages <= SIZE / PROGRAM_PAGE; a wrap of the statistics counter is harmless.
+            self.programs = self.programs.wrapping_add(pages as u32);
+        }
         let to = self.bytes.get_mut(span).ok_or(MemFlashError::OutOfBounds)?;
         // NOR flash: a write can only clear bits.
         for (t, b) in to.iter_mut().zip(bytes) {

@@ -22,6 +22,35 @@ use protocol_core::timing::{BUS_BAUD, wire_time_ns};
 /// a board whose firmware stops reading. 4 KiB is far more than any UART ring buffer in use.
 pub const RX_BUFFER_BYTES: usize = 4096;
 
+/// Bytes a UART's receive FIFO holds (the ESP32's and the ESP32-C3's): while a board stands
+/// still (a flash erase or write runs with interrupts off), what arrives beyond these is lost.
+pub const UART_FIFO_BYTES: usize = 128;
+
+/// A receiver whose board stands still: until `until_ns` it keeps at most `cap` bytes.
+#[derive(Clone, Copy, Debug)]
+struct Frozen {
+    until_ns: u64,
+    cap: usize,
+}
+
+impl Frozen {
+    /// A receiver holding `held` bytes now, frozen until `until_ns`: only its FIFO takes more.
+    fn new(held: usize, until_ns: u64) -> Self {
+        Self {
+            until_ns,
+            cap: held + UART_FIFO_BYTES,
+        }
+    }
+
+    /// How many bytes the receiver keeps for a byte arriving at `at_ns`.
+    fn cap_at(frozen: Option<Self>, at_ns: u64) -> usize {
+        match frozen {
+            Some(f) if at_ns < f.until_ns => f.cap.min(RX_BUFFER_BYTES),
+            _ => RX_BUFFER_BYTES,
+        }
+    }
+}
+
 /// A station on the [`Bus`], as returned by [`Bus::attach`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct StationId(usize);
@@ -69,6 +98,8 @@ struct Station {
     /// End of the byte this station is sending now, if any.
     sending_until_ns: Option<u64>,
     overruns: u64,
+    /// While its board stands still: only the UART's FIFO takes bytes.
+    frozen: Option<Frozen>,
 }
 
 /// The shared half-duplex bus. See the [module doc](self).
@@ -103,6 +134,16 @@ impl Bus {
     /// The 1 Mbaud bus of the myCobot 280.
     pub fn mycobot(seed: u64) -> Self {
         Self::new(BUS_BAUD, seed)
+    }
+
+    /// Station `id`'s board stands still until `until_ns` (a flash erase or write): its UART
+    /// keeps receiving into its FIFO only, bytes beyond [`UART_FIFO_BYTES`] are lost
+    /// ([`Bus::overruns`]), and what it wrote goes out only then (its loop wrote it after the
+    /// flash work, as far as the wire can tell).
+    pub fn freeze_station(&mut self, id: StationId, until_ns: u64) {
+        if let Some(station) = self.stations.get_mut(id.0) {
+            station.frozen = Some(Frozen::new(station.rx.len(), until_ns));
+        }
     }
 
     /// Duration of one byte on this bus, in ns.
@@ -191,9 +232,19 @@ impl Bus {
     /// The next instant the bus needs attention: the end of a byte on the wire.
     pub fn next_event_ns(&self) -> Option<u64> {
         let mut next = None;
-        for b in &self.in_flight {
-            if next.is_none_or(|t| b.end_ns < t) {
-                next = Some(b.end_ns);
+        let frozen_senders = self
+            .stations
+            .iter()
+            .filter(|s| !s.tx.is_empty())
+            .filter_map(|s| s.frozen.map(|f| f.until_ns));
+        for t in self
+            .in_flight
+            .iter()
+            .map(|b| b.end_ns)
+            .chain(frozen_senders)
+        {
+            if next.is_none_or(|n| t < n) {
+                next = Some(t);
             }
         }
         next
@@ -218,7 +269,7 @@ impl Bus {
                 if !station.receives {
                     continue;
                 }
-                if station.rx.len() < RX_BUFFER_BYTES {
+                if station.rx.len() < Frozen::cap_at(station.frozen, b.end_ns) {
                     station.rx.push_back(heard);
                 } else {
                     station.overruns += 1;
@@ -256,7 +307,10 @@ impl Bus {
             let Some(station) = self.stations.get_mut(index) else {
                 continue;
             };
-            if station.sending_until_ns.is_some() {
+            if station.frozen.is_some_and(|f| now_ns >= f.until_ns) {
+                station.frozen = None;
+            }
+            if station.sending_until_ns.is_some() || station.frozen.is_some() {
                 continue;
             }
             let Some(byte) = station.tx.pop_front() else {
@@ -339,6 +393,8 @@ pub struct SerialLine {
     current_start_ns: u64,
     arrived: VecDeque<u8>,
     overruns: u64,
+    /// While the receiving board stands still: only its UART's FIFO takes bytes.
+    frozen: Option<Frozen>,
 }
 
 impl SerialLine {
@@ -350,6 +406,7 @@ impl SerialLine {
             current_start_ns: 0,
             arrived: VecDeque::new(),
             overruns: 0,
+            frozen: None,
         }
     }
 
@@ -368,11 +425,26 @@ impl SerialLine {
                 break;
             };
             self.current_start_ns += self.byte_time_ns;
-            if self.arrived.len() < RX_BUFFER_BYTES {
+            if self.arrived.len() < Frozen::cap_at(self.frozen, self.current_start_ns) {
                 self.arrived.push_back(byte);
             } else {
                 self.overruns += 1;
             }
+        }
+        if self.frozen.is_some_and(|f| now_ns >= f.until_ns) {
+            self.frozen = None;
+        }
+    }
+
+    /// The receiving board stands still until `until_ns`, like [`Bus::freeze_station`].
+    pub fn freeze_receiver(&mut self, until_ns: u64) {
+        self.frozen = Some(Frozen::new(self.arrived.len(), until_ns));
+    }
+
+    /// The sending board stands still until `until_ns`: what it queued starts only then.
+    pub fn hold_sending_until(&mut self, until_ns: u64) {
+        if !self.queued.is_empty() {
+            self.current_start_ns = self.current_start_ns.max(until_ns);
         }
     }
 
@@ -448,6 +520,41 @@ mod tests {
     fn read_all(bus: &mut Bus, id: StationId) -> Vec<u8> {
         let mut port = bus.port(id).unwrap();
         std::iter::from_fn(|| port.read_byte()).collect()
+    }
+
+    #[test]
+    fn a_frozen_board_keeps_only_a_fifo_of_bytes_and_sends_when_it_goes_on() {
+        let mut bus = Bus::mycobot(1);
+        let sender = bus.attach(false);
+        let frozen = bus.attach(false);
+        bus.port(frozen).unwrap().write(&[0xAA]);
+        bus.freeze_station(frozen, 3_000_000);
+        bus.port(sender).unwrap().write(&[7; 200]);
+        run(&mut bus, 0, 2_999_999);
+        assert_eq!(read_all(&mut bus, frozen).len(), UART_FIFO_BYTES);
+        assert_eq!(bus.overruns(frozen), 200 - UART_FIFO_BYTES as u64);
+        assert!(
+            read_all(&mut bus, sender).is_empty(),
+            "nothing sent while frozen"
+        );
+        run(&mut bus, 2_999_999, 3_020_000);
+        assert_eq!(read_all(&mut bus, sender), [0xAA], "sent once it goes on");
+        // Unfrozen, the whole buffer takes bytes again.
+        bus.port(sender).unwrap().write(&[7; 200]);
+        run(&mut bus, 3_020_000, 6_000_000);
+        assert_eq!(read_all(&mut bus, frozen).len(), 200);
+    }
+
+    #[test]
+    fn a_frozen_serial_receiver_keeps_only_a_fifo_of_bytes() {
+        let mut line = SerialLine::new(HOST_BAUD);
+        line.freeze_receiver(100_000_000);
+        line.send(0, &[1; 300]);
+        line.deliver(100_000_000);
+        let mut got = Vec::new();
+        line.receive_all(&mut got);
+        assert_eq!(got.len(), UART_FIFO_BYTES);
+        assert_eq!(line.overruns(), 300 - UART_FIFO_BYTES as u64);
     }
 
     #[test]

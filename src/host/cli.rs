@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use clap::{Parser, ValueEnum};
 
-use crate::sim::HostLink;
 use crate::sim::contact::Obstacle;
+use crate::sim::{FlashTiming, HostLink};
 
 /// Virtual myCobot 280 M5: the real Basic and Atom firmware logic, simulated servos, served in
 /// real time on a pseudo-terminal (and optionally TCP) to pymycobot or any serial client, with
@@ -52,6 +52,12 @@ pub struct Cli {
     /// through what the joint's servo reports, as on the real arm.
     #[arg(long = "obstacle", value_name = "J:DEG", allow_hyphen_values = true)]
     pub obstacles: Vec<Obstacle>,
+
+    /// How long a board stands still while its flash erases or writes (loop stopped, UART
+    /// receiving into its 128-byte FIFO only): the datasheet's typical times, its worst case,
+    /// or no time at all.
+    #[arg(long, value_enum, default_value_t = FlashTiming::Typical)]
+    pub flash_timing: FlashTiming,
 
     /// The Atom is an emulated chip running the real image (tools/emulate, docs/boards.md
     /// "Emulated boards"): its bus UART (UART1) is the socket at ADDR:PORT (QEMU

@@ -74,6 +74,11 @@ impl BasicFlashStore {
         self.file.as_deref()
     }
 
+    /// The flash, to look at it (what it holds, how much it has worked).
+    pub fn flash(&self) -> Option<&BasicFlash> {
+        self.store.flash()
+    }
+
     /// The flash, to make it fail ([`MemFlash::fail_writes`]) or look at it.
     pub fn flash_mut(&mut self) -> Option<&mut BasicFlash> {
         self.store.flash_mut()

@@ -42,12 +42,14 @@
 mod basic_flash;
 pub mod contact;
 pub mod external;
+pub mod flash_timing;
 pub mod measure;
 mod robot;
 
 pub use sim_hw::{servo, wire};
 
 pub use basic_flash::{BASIC_FLASH_BYTES, BasicFlash, BasicFlashStore};
+pub use flash_timing::FlashTiming;
 pub use robot::{
     AskError, HostLink, NET_BUFFER_BYTES, NetClient, POLL_PERIOD_NS, RobotConfig, SERVO_IDS,
     SimBasicIo, VirtualRobot,

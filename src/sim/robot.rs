@@ -13,6 +13,7 @@ use protocol_core::{Frame, FrameDecoder};
 
 use super::basic_flash::BasicFlashStore;
 use super::contact::{self, Obstacle};
+use super::flash_timing::{FlashTiming, FlashWork};
 use super::servo::SimServo;
 use super::wire::{Bus, HeardByte, SerialLine, SerialPort, StationId};
 use sim_hw::ServoChain;
@@ -48,6 +49,8 @@ pub struct RobotConfig {
     pub atom_loop_us: u64,
     /// Like [`RobotConfig::atom_loop_us`] for the Basic.
     pub basic_loop_us: u64,
+    /// How long a board stands still for its flash ([`FlashTiming`], typical by default).
+    pub flash_timing: FlashTiming,
 }
 
 impl Default for RobotConfig {
@@ -65,7 +68,31 @@ impl Default for RobotConfig {
             initial_position_steps: 2048,
             atom_loop_us: 0,
             basic_loop_us: 0,
+            flash_timing: FlashTiming::Typical,
         }
+    }
+}
+
+/// Microseconds a board stood still for the flash work done between `before` and `after`.
+fn flash_busy_us(before: Option<FlashWork>, after: Option<FlashWork>, timing: FlashTiming) -> u64 {
+    match (before, after) {
+        (Some(before), Some(after)) => after.busy_us_since(before, timing),
+        _ => 0,
+    }
+}
+
+/// A board whose last pass did flash work stands still until `until_ns` (if that is after
+/// `now_ns`): no pass, only its UARTs' FIFOs take bytes, and what it wrote goes out then.
+fn stand_still_until(
+    (main_loop, station, usb): (&mut BoardLoop, StationId, &mut UsbLink),
+    bus: &mut Bus,
+    now_ns: u64,
+    until_ns: u64,
+) {
+    if until_ns > now_ns {
+        main_loop.stand_still_until(until_ns);
+        bus.freeze_station(station, until_ns);
+        usb.stand_still_until(until_ns);
     }
 }
 
@@ -143,6 +170,8 @@ impl BasicIo for SimBoardIo<'_> {
 struct BoardLoop {
     period_ns: u64,
     next_ns: u64,
+    /// While its flash keeps the board standing still: when it goes on.
+    still_until_ns: Option<u64>,
 }
 
 impl BoardLoop {
@@ -150,11 +179,18 @@ impl BoardLoop {
         Self {
             period_ns: period_us.saturating_mul(1_000),
             next_ns: 0,
+            still_until_ns: None,
         }
     }
 
     /// Whether the board runs at `now_ns`; if so, schedules its next pass.
     fn runs_at(&mut self, now_ns: u64) -> bool {
+        if let Some(until) = self.still_until_ns {
+            if now_ns < until {
+                return false;
+            }
+            self.still_until_ns = None;
+        }
         let due = now_ns >= self.next_ns;
         if due {
             self.next_ns = now_ns + self.period_ns;
@@ -162,9 +198,19 @@ impl BoardLoop {
         due
     }
 
-    /// When the next pass is due, for a board that does not run on every event.
+    /// The board stands still (its flash is erasing or writing) until `until_ns`.
+    fn stand_still_until(&mut self, until_ns: u64) {
+        self.still_until_ns = Some(until_ns);
+    }
+
+    /// When the next pass is due, for a board that does not run on every event or stands
+    /// still.
     fn next_event_ns(&self) -> Option<u64> {
-        (self.period_ns > 0).then_some(self.next_ns)
+        let periodic = (self.period_ns > 0).then_some(self.next_ns);
+        match (periodic, self.still_until_ns) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => b.or(a),
+        }
     }
 }
 
@@ -193,6 +239,13 @@ impl UsbLink {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         }
+    }
+
+    /// The board stands still until `until_ns`: its UART takes only its FIFO's worth of the
+    /// host's bytes, and what it wrote goes out then.
+    fn stand_still_until(&mut self, until_ns: u64) {
+        self.to_board.freeze_receiver(until_ns);
+        self.to_host.hold_sending_until(until_ns);
     }
 
     fn board_port(&mut self, now_ns: u64) -> SerialPort<'_> {
@@ -277,6 +330,8 @@ pub struct VirtualRobot {
     next_poll_ns: u64,
     /// Every collision the Atom detected, with the virtual time it was first seen (ns).
     collisions: Vec<(u64, Collision)>,
+    /// How long a board stands still for its flash.
+    flash_timing: FlashTiming,
 }
 
 impl VirtualRobot {
@@ -318,6 +373,7 @@ impl VirtualRobot {
             noise_station,
             next_poll_ns: 0,
             collisions: Vec::new(),
+            flash_timing: config.flash_timing,
         }
     }
 
@@ -552,17 +608,27 @@ impl VirtualRobot {
                 flash: &mut basic.flash,
             };
             let basic_us = (now_ns - basic.boot_ns) / 1_000;
+            let before = io.flash.flash().map(FlashWork::of);
             basic
                 .clients
                 .poll_basic(&mut basic.firmware, basic_us, &mut usb, &mut bus, &mut io);
+            let after = io.flash.flash().map(FlashWork::of);
+            let until = now_ns + flash_busy_us(before, after, self.flash_timing) * 1_000;
+            let board = (&mut basic.main_loop, basic.station, &mut basic.usb);
+            stand_still_until(board, &mut self.bus, now_ns, until);
         }
         if self.atom_loop.runs_at(now_ns)
             && let Some(mut bus) = self.bus.port(self.atom_station)
         {
             let mut usb = self.atom_usb.board_port(now_ns);
             let atom_us = (now_ns - self.atom_boot_ns) / 1_000;
+            let before = self.atom_io.params.flash().map(FlashWork::of);
             self.atom
                 .poll(atom_us, &mut bus, &mut usb, &mut self.atom_io);
+            let after = self.atom_io.params.flash().map(FlashWork::of);
+            let until = now_ns + flash_busy_us(before, after, self.flash_timing) * 1_000;
+            let board = (&mut self.atom_loop, self.atom_station, &mut self.atom_usb);
+            stand_still_until(board, &mut self.bus, now_ns, until);
             self.note_collision(now_ns);
         }
         self.bus.start_transmissions(now_ns);
