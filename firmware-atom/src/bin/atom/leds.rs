@@ -16,9 +16,9 @@ pub const RMT_TICK_MHZ: u32 = 80;
 /// One pulse code per data bit, plus the end marker.
 const PULSE_COUNT: usize = LED_COUNT * BITS_PER_LED + 1;
 /// Longest a colour may take to leave before the update is abandoned, microseconds: the
-/// chain's wire time is 0.75 ms (600 bits of 1.25 us), and the RMT is done 0.75 ms after its
-/// start whatever the loop does, so 2 ms is only ever reached by a channel that is stuck (a
-/// missed end flag, an RMT fault, an emulator without an RMT).
+/// chain's wire time is 0.75 ms (600 bits of 1.25 us) and [`Leds::fill`] polls the channel
+/// without a pause meanwhile, so 2 ms is only ever reached by a channel that is stuck (a missed
+/// end flag, an RMT fault, an emulator without an RMT).
 pub const FILL_DEADLINE_US: u64 = 2_000;
 
 // WS2812 bit timing in 12.5 ns ticks: a 0 is 0.40 us high + 0.85 us low, a 1 is 0.80 us high +
