@@ -1,5 +1,5 @@
 //! What the Atom and the Basic board binaries share on the chip: the UART as a
-//! [`protocol_core::BytePort`], the clock, waits with a deadline, the loop watchdog, logging on
+//! `protocol_core::BytePort`, the clock, waits with a deadline, the loop watchdog, logging on
 //! UART0 (off unless the `log-uart0` feature is on, because UART0 is a host link) and the panic
 //! policy (restart).
 //!
