@@ -1,20 +1,27 @@
 //! What the Atom and the Basic board binaries share on the chip: the UART as a
-//! [`protocol_core::BytePort`], the clock, the loop watchdog, logging on UART0 (off unless the
-//! `log-uart0` feature is on, because UART0 is a host link) and the panic policy (restart).
+//! `protocol_core::BytePort`, the clock, waits with a deadline, the loop watchdog, logging on
+//! UART0 (off unless the `log-uart0` feature is on, because UART0 is a host link) and the panic
+//! policy (restart).
 //!
-//! Built only for a chip (`target_os = "none"`); on the host the crate is empty, so workspace
-//! builds and tests never see esp-hal.
-#![no_std]
+//! Everything that touches esp-hal is built only for a chip (`target_os = "none"`), so
+//! workspace builds and tests never see esp-hal; on the host the crate is [`deadline`] alone,
+//! the pure logic of the waits, with its tests.
+#![cfg_attr(not(test), no_std)]
 #![deny(unsafe_code)]
-#![cfg(target_os = "none")]
 
+pub mod deadline;
+#[cfg(target_os = "none")]
 pub mod uart_port;
+#[cfg(target_os = "none")]
 pub mod watchdog;
 
+pub use deadline::{Deadline, TimedOut, wait_until};
+#[cfg(target_os = "none")]
 pub use uart_port::{UartPort, now_us};
+#[cfg(target_os = "none")]
 pub use watchdog::LoopWatchdog;
 
-#[cfg(feature = "log-uart0")]
+#[cfg(all(target_os = "none", feature = "log-uart0"))]
 #[doc(hidden)]
 pub use esp_println;
 
@@ -36,6 +43,7 @@ macro_rules! board_log {
 
 /// Nothing reachable from received bytes panics (the libraries are tested for it); a panic is
 /// a firmware bug, and a restart is the quickest way back to a working arm.
+#[cfg(target_os = "none")]
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
     board_log!("panic: {}", info);

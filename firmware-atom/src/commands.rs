@@ -538,10 +538,7 @@ fn execute<I: AtomIo>(
             Answer::Done(registers::calibrate(cx, motion, gripper, GRIPPER))
         }
         R::IsGripperMoving => byte(bank.servo_moving(now_us, GRIPPER)),
-        R::SetColor { rgb } => {
-            io.set_rgb(rgb.r, rgb.g, rgb.b);
-            done()
-        }
+        R::SetColor { rgb } => done_if(io.set_rgb(rgb.r, rgb.g, rgb.b)),
         R::SetHtsGripperTorque { torque } => {
             gripper.set_torque(torque);
             Answer::Now(Reply::Byte(1))

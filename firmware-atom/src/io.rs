@@ -40,7 +40,9 @@ pub enum PinMode {
 }
 
 /// Pins, PWM, the RGB LEDs and the button of the Atom. Implemented by the board layer (GPIO,
-/// LEDC, RMT) and by the virtual robot. Every method returns at once.
+/// LEDC, RMT) and by the virtual robot. Every method returns at once or, where the hardware
+/// needs time (the LEDs' data, flash), by a deadline: a peripheral that does not answer makes
+/// the call fail, never wait for ever (docs/boards.md, "Waits and their bounds").
 pub trait AtomIo {
     /// Configures `pin`; `false` if the board refuses.
     fn set_pin_mode(&mut self, pin: u8, mode: PinMode) -> bool;
@@ -50,8 +52,9 @@ pub trait AtomIo {
     fn read_pin(&mut self, pin: u8) -> Option<bool>;
     /// Starts PWM on `pin` at `freq_hz` with duty `duty_0_255` / 255; `false` if refused.
     fn set_pwm(&mut self, pin: u8, freq_hz: u16, duty_0_255: u8) -> bool;
-    /// Sets every RGB LED of the Atom to one colour (0..255 per channel).
-    fn set_rgb(&mut self, red: u8, green: u8, blue: u8);
+    /// Sets every RGB LED of the Atom to one colour (0..255 per channel); `false` if the LEDs
+    /// did not take it (none, or their data did not leave by its deadline).
+    fn set_rgb(&mut self, red: u8, green: u8, blue: u8) -> bool;
     /// True while the Atom's button (GPIO39, active low) is held down.
     fn button_pressed(&mut self) -> bool;
     /// The flash store of servo parameter backups (0xEA/0xEB); `None` if the board has none.
@@ -104,6 +107,9 @@ pub struct RecordingIo {
     pub pwm: [Option<(u16, u8)>; 4],
     /// Last colour set on the LEDs (red, green, blue).
     pub rgb: (u8, u8, u8),
+    /// The LEDs take no colour (a stuck or missing LED chain): [`AtomIo::set_rgb`] fails and
+    /// [`Self::rgb`] stays.
+    pub leds_fail: bool,
     /// Whether the button is held.
     pub button: bool,
     /// Pulse the accessory servo gets every 20 ms, microseconds (`None`: no pulses).
@@ -119,6 +125,7 @@ impl Default for RecordingIo {
             levels: Default::default(),
             pwm: Default::default(),
             rgb: Default::default(),
+            leds_fail: false,
             button: false,
             wiring: Default::default(),
             accessory_servo_pulse_us: None,
@@ -209,8 +216,12 @@ impl AtomIo for RecordingIo {
         }
     }
 
-    fn set_rgb(&mut self, red: u8, green: u8, blue: u8) {
+    fn set_rgb(&mut self, red: u8, green: u8, blue: u8) -> bool {
+        if self.leds_fail {
+            return false;
+        }
         self.rgb = (red, green, blue);
+        true
     }
 
     fn button_pressed(&mut self) -> bool {

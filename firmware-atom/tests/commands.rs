@@ -348,6 +348,25 @@ fn pins_leds_and_button() {
 }
 
 #[test]
+fn leds_that_take_no_colour_make_set_color_answer_an_error() {
+    let mut rig = Rig::new();
+    assert_eq!(rig.ask(0x6A, &[1, 2, 3]), [1]);
+    // The board's LED update failed (its RMT data did not leave by the deadline).
+    rig.io.leds_fail = true;
+    assert_eq!(
+        rig.ask(0x6A, &[255, 0, 10]),
+        [0],
+        "refused, not a silent ok"
+    );
+    assert_eq!(rig.io.rgb, (1, 2, 3));
+    // The Atom goes on: the next commands are answered, the next colour is shown.
+    assert_eq!(rig.ask(0x62, &[22]), [22, 0]);
+    rig.io.leds_fail = false;
+    assert_eq!(rig.ask(0x6A, &[255, 0, 10]), [1]);
+    assert_eq!(rig.io.rgb, (255, 0, 10));
+}
+
+#[test]
 fn every_command_gets_one_reply_with_its_cmd_even_when_invalid() {
     let mut rig = Rig::new();
     for (cmd, data) in [

@@ -74,6 +74,16 @@ class InputsAndOutputs(RobotTestCase):
         self.assertEqual(self.mc.get_error_information(), 0)
         self.assertEqual(self.mc.is_power_on(), 1, "still answering after the pin commands")
 
+    def test_set_color_is_answered_and_the_atom_goes_on(self):
+        # The LEDs' RMT transmission has a 2 ms deadline (docs/boards.md, "Waits and their
+        # bounds"): where the emulator has no RMT (the C3 machine) the colour is answered 0
+        # instead of hanging the Atom.
+        for rgb in [(0, 250, 0), (255, 0, 254)]:
+            self.assertIn(self.mc.set_color(*rgb), (0, 1), f"set_color{rgb}")
+        self.assertEqual(self.mc.is_power_on(), 1, "still answering after set_color")
+        angles = self.mc.get_angles()
+        self.assertTrue(isinstance(angles, list) and len(angles) == 6, f"get_angles: {angles!r}")
+
 
 class BadInputAndErrors(RobotTestCase):
     def test_bad_requests_change_nothing(self):

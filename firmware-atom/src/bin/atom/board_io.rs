@@ -14,6 +14,8 @@ use esp_storage::FlashStorage;
 use firmware_atom::io::{AtomIo, OUTPUT_PINS, PinMode};
 use firmware_atom::store::{FlashParams, ParamStore};
 
+use board_support::board_log;
+
 use crate::{
     leds::Leds,
     pwm::{duty_bits, duty_ticks},
@@ -81,6 +83,8 @@ pub struct BoardIo<'d> {
     /// Which user pins currently output PWM.
     pwm_on: [bool; 4],
     leds: Option<Leds<'d>>,
+    /// LED updates that failed since boot (logged with `log-uart0`).
+    led_failures: u32,
     button: Input<'d>,
     /// The accessory hobby servo (ESP32 only).
     #[cfg(feature = "esp32")]
@@ -104,6 +108,7 @@ impl<'d> BoardIo<'d> {
             params: FlashParams::new(flash, PARAMS_FLASH),
             pwm_on: [false; 4],
             leds,
+            led_failures: 0,
             button,
             #[cfg(feature = "esp32")]
             accessory: None,
@@ -243,9 +248,17 @@ impl AtomIo for BoardIo<'_> {
         on
     }
 
-    fn set_rgb(&mut self, red: u8, green: u8, blue: u8) {
-        if let Some(leds) = &mut self.leds {
-            leds.fill(red, green, blue);
+    fn set_rgb(&mut self, red: u8, green: u8, blue: u8) -> bool {
+        let Some(leds) = &mut self.leds else {
+            return false;
+        };
+        match leds.fill(red, green, blue) {
+            Ok(()) => true,
+            Err(error) => {
+                self.led_failures = self.led_failures.wrapping_add(1);
+                board_log!("LED update {:?} ({} so far)", error, self.led_failures);
+                false
+            }
         }
     }
 

@@ -43,6 +43,8 @@ esp_bootloader_esp_idf::esp_app_desc!();
 #[main]
 fn main() -> ! {
     let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
+    // Armed before anything that could hang: from here on only the loop below feeds it.
+    let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, p.TIMG1, now_us());
     let pins = pins::chip::take_pins!(p);
     board_log!("open-mycobot atom {}", env!("CARGO_PKG_VERSION"));
 
@@ -98,8 +100,6 @@ fn main() -> ! {
     if let Some(error) = atom.config_error() {
         board_log!("configuration refused, running defaults: {:?}", error);
     }
-
-    let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, now_us());
 
     loop {
         let now = now_us();

@@ -82,6 +82,9 @@ const HEAP_BYTES: usize = 36 * 1024;
 #[main]
 fn main() -> ! {
     let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
+    // Armed before anything that could hang (the LCD's set-up, the Wi-Fi scheduler and radio):
+    // from here on only the loop below feeds it.
+    let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, p.TIMG1, now_us());
     let mut pins = pins::chip::take_pins!(p);
     // Through the embedded-hal trait, so this line means the same on every chip: a fixed output
     // is an `Output` on the ESP32 and a `NoPin` on the C3 stand-in, both infallible.
@@ -135,9 +138,6 @@ fn main() -> ! {
     let mut io = io;
 
     let mut basic = Basic::new(BasicConfig::default());
-
-    // Armed before anything that could hang: from here on only the loop below feeds it.
-    let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, now_us());
 
     // Wi-Fi needs the scheduler running before the radio starts. The radio starts on a thread
     // of its own, so the loop serves USB from its first pass whatever the radio does; one that
