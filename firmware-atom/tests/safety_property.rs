@@ -7,6 +7,10 @@
 
 mod support;
 
+#[path = "replay_seeds/mod.rs"]
+mod replay_seeds;
+use replay_seeds::ReplaySeeds;
+
 use firmware_atom::config::FACTORY_LIMITS;
 use firmware_atom::{AtomConfig, JointLimit};
 use proptest::prelude::*;
@@ -105,7 +109,7 @@ fn within(limit: &JointLimit, steps: i16, config: &AtomConfig, j: usize) -> bool
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 48, failure_persistence: Some(Box::new(ReplaySeeds(include_str!("safety_property.proptest-regressions")))), ..ProptestConfig::default() })]
 
     #[test]
     fn no_input_sends_an_out_of_limit_goal(inputs in prop::collection::vec(input(), 1..24)) {
@@ -158,7 +162,7 @@ fn raw_write() -> impl Strategy<Value = (u8, u8, u16, bool)> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 48, failure_persistence: Some(Box::new(ReplaySeeds(include_str!("safety_property.proptest-regressions")))), ..ProptestConfig::default() })]
 
     #[test]
     fn no_raw_write_moves_a_joints_zero_or_its_range(writes in prop::collection::vec(raw_write(), 1..16)) {

@@ -4,6 +4,10 @@
 
 mod common;
 
+#[path = "../../firmware-atom/tests/replay_seeds/mod.rs"]
+mod replay_seeds;
+use replay_seeds::ReplaySeeds;
+
 use common::{HOST_BYTE_NS, Rig, frame};
 use firmware_basic::{Basic, BasicConfig, EchoMode, NullIo};
 use proptest::prelude::*;
@@ -61,7 +65,7 @@ fn stream() -> impl Strategy<Value = Vec<u8>> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 128, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 128, failure_persistence: Some(Box::new(ReplaySeeds(include_str!("properties.proptest-regressions")))), ..ProptestConfig::default() })]
 
     /// Any bytes on either side, any timing, any transmitter state: the Basic never panics,
     /// and afterwards it still answers: "set framed mode" then "get Basic version" get their
