@@ -157,11 +157,11 @@ fn serve_emulated(
     // The Atom, the bus's master, starts a frame on a line with no byte under way; the Basic
     // waits for the silence it waits for on the real bus.
     let mut buses = vec![(
-        Chardev::connect("Atom's bus UART", atom, CONNECT_TIMEOUT)?,
+        Chardev::connect("Atom's bus UART", atom, CONNECT_TIMEOUT, stop)?,
         0,
     )];
     if let Some(basic) = cli.emulated_basic {
-        let chardev = Chardev::connect("Basic's bus UART", basic, CONNECT_TIMEOUT)?;
+        let chardev = Chardev::connect("Basic's bus UART", basic, CONNECT_TIMEOUT, stop)?;
         buses.push((chardev, protocol_core::timing::BUS_QUIET_BEFORE_SEND_US));
     }
     let front_name = if cli.emulated_basic.is_some() {
@@ -169,7 +169,7 @@ fn serve_emulated(
     } else {
         "Atom's host UART"
     };
-    let front = Chardev::connect(front_name, host, CONNECT_TIMEOUT)?;
+    let front = Chardev::connect(front_name, host, CONNECT_TIMEOUT, stop)?;
     let mut out = std::io::stdout().lock();
     let boards = if cli.emulated_basic.is_some() {
         "the emulated Basic and Atom"

@@ -1,8 +1,8 @@
 //! The command line of the virtual robot as a user meets it: start-up banner (naming the board
 //! whose port it serves), the pty symlink (stale ones replaced, user files never clobbered,
 //! removed on Ctrl-C, one robot per link: a second one refuses, a link taken over is left to
-//! its new owner), the 3D view's address, and clear errors. Speaks raw frames on the
-//! pseudo-terminal, so it needs no Python.
+//! its new owner), Ctrl-C with clients connected, the 3D view's address, and clear errors.
+//! Speaks raw frames on the pseudo-terminal, so it needs no Python.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
 use std::fs::{self, OpenOptions};
@@ -243,4 +243,59 @@ fn the_link_of_a_killed_robot_is_taken_over() {
     let next = launch(&["--pty-link", link.to_str().unwrap(), "--no-web"]);
     assert_eq!(fs::read_link(&link).unwrap(), pts_of(&next));
     assert_powered_on(&link);
+}
+
+/// Longest a test lets the robot take to exit after Ctrl-C: generous, for a loaded machine
+/// (an idle one takes a few milliseconds).
+const CTRL_C_DEADLINE: Duration = Duration::from_secs(3);
+
+#[test]
+fn ctrl_c_with_clients_connected_exits_at_once() {
+    let dir = scratch("ctrl-c");
+    let link = dir.join("mycobot");
+    let mut robot = launch(&[
+        "--pty-link",
+        link.to_str().unwrap(),
+        "--tcp",
+        "127.0.0.1:0",
+        "--web",
+        "127.0.0.1:0",
+        "--basic-flash",
+        dir.join("flash.bin").to_str().unwrap(),
+    ]);
+    // A serial client that keeps the port open, a TCP client, and a page's state stream.
+    assert_powered_on(&link);
+    let _serial = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(&link)
+        .unwrap();
+    let mut tcp = TcpStream::connect(robot.banner_value("tcp on ").unwrap()).unwrap();
+    tcp.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    tcp.write_all(&[0xFE, 0xFE, 0x02, 0x12, 0xFA]).unwrap();
+    let mut reply = [0u8; 6];
+    tcp.read_exact(&mut reply).unwrap();
+    assert_eq!(reply, [0xFE, 0xFE, 0x03, 0x12, 0x01, 0xFA]);
+    let view = robot.banner_value("view on http://").unwrap();
+    let mut stream = TcpStream::connect(view).unwrap();
+    write!(
+        stream,
+        "GET /state HTTP/1.1\r\nHost: {view}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n\
+         Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n"
+    )
+    .unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(5)))
+        .unwrap();
+    let mut head = [0u8; 12];
+    stream.read_exact(&mut head).unwrap();
+    assert_eq!(&head, b"HTTP/1.1 101", "the stream did not open");
+
+    let asked = std::time::Instant::now();
+    let exit = robot.stop_with(Signal::SIGINT);
+    let took = asked.elapsed();
+    eprintln!("exit after Ctrl-C with clients connected: {took:?}");
+    assert!(exit.is_some_and(|s| s.success()), "exit: {exit:?}");
+    assert!(took < CTRL_C_DEADLINE, "took {took:?}");
+    assert!(fs::symlink_metadata(&link).is_err(), "link left behind");
 }
