@@ -6,6 +6,7 @@ use std::io::Write;
 use std::net::Ipv4Addr;
 use std::process::ExitCode;
 use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 use clap::Parser;
 use firmware_atom::collision::Collision;
@@ -36,8 +37,15 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
     let stop = stop_on_signals()?;
     let pty =
         PseudoTerminal::open().map_err(|e| format!("cannot create a pseudo-terminal: {e}"))?;
+    // The link before anything else is taken (the TCP port, the view's): a second robot on a
+    // link that a running one serves says so, not that the port is in use.
+    let link = cli
+        .pty_link
+        .as_deref()
+        .map(|path| PtyLink::create(path, pty.slave_path()))
+        .transpose()?;
     if let Some(atom) = cli.emulated_atom {
-        return serve_emulated(cli, atom, stop, pty);
+        return serve_emulated(cli, atom, &stop, pty, link);
     }
     let flash_file = cli.basic_flash.clone().or_else(default_basic_flash);
     let mut flash = match &flash_file {
@@ -55,7 +63,6 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
             TcpServer::bind(addr).map_err(|e| format!("cannot listen on {addr}: {e}"))
         })
         .transpose()?;
-    let link = pty_link(cli, &pty)?;
 
     let board = Arc::new(StateBoard::new());
     let view = if cli.no_web {
@@ -144,8 +151,9 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
 fn serve_emulated(
     cli: &Cli,
     atom: std::net::SocketAddr,
-    stop: Arc<std::sync::atomic::AtomicBool>,
+    stop: &AtomicBool,
     pty: PseudoTerminal,
+    link: Option<PtyLink>,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let host = cli
         .emulated_host
@@ -153,11 +161,11 @@ fn serve_emulated(
     // The Atom, the bus's master, starts a frame on a line with no byte under way; the Basic
     // waits for the silence it waits for on the real bus.
     let mut buses = vec![(
-        Chardev::connect("Atom's bus UART", atom, CONNECT_TIMEOUT)?,
+        Chardev::connect("Atom's bus UART", atom, CONNECT_TIMEOUT, stop)?,
         0,
     )];
     if let Some(basic) = cli.emulated_basic {
-        let chardev = Chardev::connect("Basic's bus UART", basic, CONNECT_TIMEOUT)?;
+        let chardev = Chardev::connect("Basic's bus UART", basic, CONNECT_TIMEOUT, stop)?;
         buses.push((chardev, protocol_core::timing::BUS_QUIET_BEFORE_SEND_US));
     }
     let front_name = if cli.emulated_basic.is_some() {
@@ -165,8 +173,7 @@ fn serve_emulated(
     } else {
         "Atom's host UART"
     };
-    let front = Chardev::connect(front_name, host, CONNECT_TIMEOUT)?;
-    let link = pty_link(cli, &pty)?;
+    let front = Chardev::connect(front_name, host, CONNECT_TIMEOUT, stop)?;
     let mut out = std::io::stdout().lock();
     let boards = if cli.emulated_basic.is_some() {
         "the emulated Basic and Atom"
@@ -195,7 +202,7 @@ fn serve_emulated(
     drop(out);
 
     let robot = EmulatedBoards::new(arm, buses, front);
-    RealtimeDriver::new(robot, pty, None).run(&stop)?;
+    RealtimeDriver::new(robot, pty, None).run(stop)?;
     drop(link);
     let _ = writeln!(std::io::stdout(), "stopped");
     Ok(())
@@ -212,15 +219,4 @@ fn collision_line(at_ns: u64, collision: &Collision) -> String {
         f64::from(collision.load_permille) / 10.0,
         at_ns as f64 / 1e9
     )
-}
-
-/// The `--pty-link` symlink to the pseudo-terminal, if asked for.
-fn pty_link(cli: &Cli, pty: &PseudoTerminal) -> Result<Option<PtyLink>, String> {
-    cli.pty_link
-        .as_deref()
-        .map(|path| {
-            PtyLink::create(path, pty.slave_path())
-                .map_err(|e| format!("cannot create the link {}: {e}", path.display()))
-        })
-        .transpose()
 }

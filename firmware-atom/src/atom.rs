@@ -271,3 +271,259 @@ impl Atom {
         (self.parts.drag.recorded(), self.parts.drag.is_recording())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::vec::Vec;
+
+    use protocol_core::FrameDecoder;
+    use protocol_core::command::cmd;
+    use protocol_core::servo::{Instruction, reg};
+    use protocol_core::timing::HOST_BAUD;
+    use sim_hw::wire::SerialPort;
+    use sim_hw::{Bus, HeardByte, SerialLine, ServoChain, SimServo, StationId};
+
+    use super::*;
+    use crate::io::RecordingIo;
+    use crate::store::{COLLISION_SETTINGS_KEY, ParamStore};
+
+    /// How often the Atom is polled, microseconds (it must be at least every 10 us).
+    const TICK_US: u64 = 5;
+    /// The bus ids of the arm's servos: joints 1..=6, then the gripper.
+    const IDS: core::ops::RangeInclusive<u8> = 1..=7;
+    /// `is_power_on` (0x12) as a host sends it.
+    const IS_POWER_ON: [u8; 5] = [0xFE, 0xFE, 0x02, cmd::IS_POWER_ON, 0xFA];
+
+    /// The Atom on the simulated 1 Mbaud wire with the arm's seven servos (torque on, as in an
+    /// arm powered before the Atom booted), its USB serial (115200 both ways) and its IO, in
+    /// virtual time.
+    struct Arm {
+        atom: Atom,
+        wire: Bus,
+        station: StationId,
+        servos: ServoChain,
+        usb_to_atom: SerialLine,
+        usb_from_atom: SerialLine,
+        io: RecordingIo,
+        now_us: u64,
+        /// Host frames the Atom sent on the wire.
+        frames_on_bus: Vec<Frame>,
+        bus_frames: FrameDecoder,
+    }
+
+    impl Arm {
+        fn new(config: AtomConfig, io: RecordingIo) -> Self {
+            let mut wire = Bus::mycobot(7);
+            wire.set_tap(true); // the servos hear the wire through the tap
+            let station = wire.attach(true);
+            let mut servos = ServoChain::new();
+            for id in IDS {
+                let mut servo = SimServo::new(id, 2048);
+                let torque_on = Instruction::Write {
+                    addr: reg::TORQUE_ENABLE,
+                    data: &[1],
+                };
+                servo.receive(&torque_on.to_packet(id).unwrap(), 0);
+                servos.attach(&mut wire, servo);
+            }
+            Self {
+                atom: Atom::new(config),
+                wire,
+                station,
+                servos,
+                usb_to_atom: SerialLine::new(HOST_BAUD),
+                usb_from_atom: SerialLine::new(HOST_BAUD),
+                io,
+                now_us: 0,
+                frames_on_bus: Vec::new(),
+                bus_frames: FrameDecoder::new(),
+            }
+        }
+
+        /// Runs the wire, the servos and the Atom for `us` microseconds.
+        fn run_us(&mut self, us: u64) {
+            let end = self.now_us + us;
+            while self.now_us < end {
+                self.now_us += TICK_US;
+                let now_ns = self.now_us * 1_000;
+                let mut heard: Vec<HeardByte> = Vec::new();
+                self.wire.deliver(now_ns);
+                self.wire.take_heard(&mut heard);
+                for byte in &heard {
+                    self.servos.hear(byte);
+                    if byte.from == self.station {
+                        let frames = &mut self.frames_on_bus;
+                        self.bus_frames.feed(&[byte.byte], |f| frames.push(f));
+                    }
+                }
+                self.servos.transmit_due(now_ns, &mut self.wire);
+                self.usb_to_atom.deliver(now_ns);
+                self.usb_from_atom.deliver(now_ns);
+                let mut bus = self.wire.port(self.station).unwrap();
+                let mut usb = SerialPort {
+                    rx: &mut self.usb_to_atom,
+                    tx: &mut self.usb_from_atom,
+                    now_ns,
+                };
+                self.atom
+                    .poll(self.now_us, &mut bus, &mut usb, &mut self.io);
+                self.wire.start_transmissions(now_ns);
+            }
+        }
+
+        fn run_ms(&mut self, ms: u64) {
+            self.run_us(ms * 1_000);
+        }
+
+        /// Sends `bytes` on the Atom's USB and returns the data of the frames it answered there
+        /// within 100 ms.
+        fn usb_exchange(&mut self, bytes: &[u8]) -> Vec<Vec<u8>> {
+            self.usb_to_atom.send(self.now_us * 1_000, bytes);
+            self.run_ms(100);
+            let mut received = Vec::new();
+            self.usb_from_atom.receive_all(&mut received);
+            let mut replies = Vec::new();
+            FrameDecoder::new().feed(&received, |f| replies.push(f.data().to_vec()));
+            replies
+        }
+
+        /// Asks `code` with `data` on the Atom's USB; the data of its one reply.
+        fn ask(&mut self, code: u8, data: &[u8]) -> Vec<u8> {
+            let replies = self.usb_exchange(&Frame::new(code, data).unwrap().to_bytes());
+            assert_eq!(replies.len(), 1, "replies to {code:#04x}: {replies:?}");
+            replies.into_iter().next().unwrap_or_default()
+        }
+
+        /// Presses (`true`) or lets go of the Atom's button, and runs 20 ms.
+        fn hold_button(&mut self, pressed: bool) {
+            self.io.button = pressed;
+            self.run_ms(20);
+        }
+
+        /// Whether each servo (joints 1..=6, gripper) holds torque.
+        fn torque(&self) -> Vec<bool> {
+            IDS.map(|id| self.servos.get(id).unwrap().torque_enabled())
+                .collect()
+        }
+    }
+
+    fn powered() -> AtomConfig {
+        AtomConfig {
+            powered_at_boot: true,
+            ..AtomConfig::default()
+        }
+    }
+
+    /// The real arm, powered, with nothing in flash, after its first 50 ms.
+    fn powered_arm() -> Arm {
+        let mut arm = Arm::new(powered(), RecordingIo::default());
+        arm.run_ms(50);
+        arm
+    }
+
+    #[test]
+    fn a_refused_configuration_boots_the_default_one_and_says_why() {
+        // The gripper on the broadcast id: refused, so the arm runs with the real ids.
+        let bad = AtomConfig {
+            servo_ids: [1, 2, 3, 4, 5, 6, 0xFE],
+            ..powered()
+        };
+        let mut arm = Arm::new(bad, RecordingIo::default());
+        assert_eq!(arm.atom.config_error(), Some(ConfigError::BadServoId));
+        assert_eq!(arm.atom.config(), &AtomConfig::default());
+        arm.run_ms(50);
+        assert_eq!(
+            arm.ask(cmd::IS_SERVO_ENABLED, &[7]),
+            [7, 1],
+            "the gripper, servo 7, is read and holds"
+        );
+
+        let good = Atom::new(powered());
+        assert_eq!(good.config_error(), None);
+        assert!(
+            good.config().powered_at_boot,
+            "a valid configuration is kept"
+        );
+    }
+
+    /// Flash holding collision protection off and joint 2's threshold at 180.
+    fn flash_with_collision_settings() -> RecordingIo {
+        let mut io = RecordingIo::default();
+        let mut stored = CollisionSettings::new(false);
+        stored.set_threshold(2, 180).unwrap();
+        stored.save(&mut io.params).unwrap();
+        io
+    }
+
+    #[test]
+    fn collision_settings_kept_in_flash_are_in_force_from_the_first_poll() {
+        let mut arm = Arm::new(powered(), flash_with_collision_settings());
+        arm.run_us(TICK_US);
+        assert_eq!(arm.ask(cmd::GET_COLLISION_MODE, &[]), [0]);
+        assert_eq!(
+            arm.ask(cmd::GET_COLLISION_THRESHOLDS, &[]),
+            [100, 180, 100, 100, 100, 100]
+        );
+        // Read once, at boot: the flash is not read again on every poll.
+        CollisionSettings::new(true)
+            .save(&mut arm.io.params)
+            .unwrap();
+        assert_eq!(arm.ask(cmd::GET_COLLISION_MODE, &[]), [0]);
+    }
+
+    #[test]
+    fn a_record_that_is_not_valid_settings_leaves_the_defaults() {
+        let mut io = RecordingIo::default();
+        io.params.store(COLLISION_SETTINGS_KEY, &[1, 7, 7]).unwrap();
+        let mut arm = Arm::new(powered(), io);
+        assert_eq!(arm.ask(cmd::GET_COLLISION_MODE, &[]), [1]);
+        assert_eq!(arm.ask(cmd::GET_COLLISION_THRESHOLDS, &[]), [100; 6]);
+    }
+
+    #[test]
+    fn the_button_releases_the_joints_while_held_in_free_mode_only() {
+        let mut arm = powered_arm();
+        assert_eq!(arm.torque(), [true; 7]);
+        arm.hold_button(true);
+        assert_eq!(
+            arm.torque(),
+            [true; 7],
+            "free mode off: the button does nothing"
+        );
+        arm.hold_button(false);
+
+        assert_eq!(arm.ask(cmd::SET_FREE_MODE, &[1]), [1]);
+        arm.hold_button(true);
+        let mut joints_limp = [false; 7];
+        joints_limp[6] = true;
+        assert_eq!(
+            arm.torque(),
+            joints_limp,
+            "the joints limp, the gripper holds"
+        );
+        arm.hold_button(false);
+        assert_eq!(arm.torque(), [true; 7], "released: every joint holds again");
+    }
+
+    #[test]
+    fn the_button_does_not_power_an_arm_that_was_switched_off() {
+        let mut arm = powered_arm();
+        assert_eq!(arm.ask(cmd::SET_FREE_MODE, &[1]), [1]);
+        assert_eq!(arm.ask(cmd::POWER_OFF, &[]), [1]);
+        assert_eq!(arm.torque(), [false; 7]);
+        arm.hold_button(true);
+        arm.hold_button(false);
+        assert_eq!(arm.torque(), [false; 7], "pressing and releasing it");
+    }
+
+    #[test]
+    fn a_request_on_the_atoms_usb_is_answered_there_and_never_on_the_bus() {
+        let mut arm = powered_arm();
+        assert_eq!(arm.usb_exchange(&IS_POWER_ON), [[1]]);
+        assert!(arm.frames_on_bus.is_empty(), "{:?}", arm.frames_on_bus);
+        // A client killed in the middle of a frame (a header announcing 16 bytes), then the
+        // next one, after a pause: its request is answered, once.
+        assert!(arm.usb_exchange(&[0xFE, 0xFE, 0x10, 0x20]).is_empty());
+        assert_eq!(arm.usb_exchange(&IS_POWER_ON), [[1]]);
+    }
+}

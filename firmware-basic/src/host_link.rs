@@ -204,3 +204,134 @@ fn collect(heard: Heard, frames: &mut HostFrames) {
         let _ = frames.push(frame);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `GET_ANGLES` (0x20), as pymycobot sends it.
+    const GET_ANGLES: [u8; 5] = [0xFE, 0xFE, 0x02, 0x20, 0xFA];
+
+    /// Hears `bytes` from the client, one every 87 us (115200 baud) from `start_us`; returns
+    /// the frames they completed.
+    fn hear_all(link: &mut HostLink, start_us: u64, bytes: &[u8]) -> std::vec::Vec<Frame> {
+        let mut heard = std::vec::Vec::new();
+        for (i, &byte) in bytes.iter().enumerate() {
+            let mut frames = HostFrames::new();
+            link.hear(start_us + 87 * i as u64, byte, &mut frames);
+            heard.extend(frames);
+        }
+        heard
+    }
+
+    /// What `link` hands the port, chunk by chunk, until its queue is empty.
+    fn drain(link: &mut HostLink) -> std::vec::Vec<u8> {
+        let mut out = std::vec::Vec::new();
+        while let Some(chunk) = link.next_chunk(true) {
+            assert!(!chunk.is_empty() && chunk.len() <= HOST_WRITE_CHUNK);
+            out.extend_from_slice(&chunk);
+        }
+        out
+    }
+
+    #[test]
+    fn only_host_frames_are_heard_not_servo_packets_or_noise() {
+        let mut link = HostLink::new(LinkKind::Serial);
+        // A servo ping (a transparent-mode tool's bytes sent in framed mode), then line noise.
+        let ping = [0xFF, 0xFF, 0x01, 0x02, 0x01, 0xFB];
+        assert!(hear_all(&mut link, 0, &ping).is_empty());
+        assert!(hear_all(&mut link, 1_000, &[0x00, 0xFA, 0x13]).is_empty());
+        let heard = hear_all(&mut link, 2_000, &GET_ANGLES);
+        assert_eq!(heard.len(), 1, "{heard:?}");
+        assert_eq!(heard.first().map(Frame::cmd), Some(0x20));
+    }
+
+    #[test]
+    fn a_pause_inside_a_frame_cuts_it_on_a_serial_line_but_not_over_the_network() {
+        // The client writes the first half, stalls 5 ms, then writes the rest: longer than the
+        // serial line's gap, shorter than a network link's.
+        let pause_us = 5_000;
+        let (first, rest) = GET_ANGLES.split_at(2);
+        for (kind, whole) in [(LinkKind::Serial, false), (LinkKind::Network, true)] {
+            let mut link = HostLink::new(kind);
+            assert!(hear_all(&mut link, 0, first).is_empty());
+            let mut frames = HostFrames::new();
+            link.check_gap(pause_us, &mut frames);
+            assert!(frames.is_empty());
+            let heard = hear_all(&mut link, pause_us, rest);
+            assert_eq!(heard.len() == 1, whole, "{kind:?}: {heard:?}");
+        }
+    }
+
+    #[test]
+    fn a_frame_inside_one_cut_short_comes_out_after_the_gap() {
+        let mut link = HostLink::new(LinkKind::Serial);
+        // A header that announces 16 bytes (a client killed mid-write), then a whole request:
+        // it is read as part of the first until the line has been quiet for the gap.
+        let mut bytes = std::vec![0xFE, 0xFE, 0x10];
+        bytes.extend_from_slice(&GET_ANGLES);
+        assert!(hear_all(&mut link, 0, &bytes).is_empty());
+        let mut frames = HostFrames::new();
+        link.check_gap(1_000, &mut frames);
+        assert!(frames.is_empty(), "not quiet long enough yet");
+        link.check_gap(1_000 + timing::HOST_FRAME_GAP_US, &mut frames);
+        assert_eq!(frames.len(), 1, "{frames:?}");
+        assert_eq!(frames.first().map(Frame::cmd), Some(0x20));
+    }
+
+    #[test]
+    fn a_mode_change_forgets_a_partial_frame() {
+        let mut link = HostLink::new(LinkKind::Serial);
+        let (first, rest) = GET_ANGLES.split_at(3);
+        assert!(hear_all(&mut link, 0, first).is_empty());
+        link.reset_framer();
+        assert!(hear_all(&mut link, 300, rest).is_empty());
+        assert_eq!(hear_all(&mut link, 600, &GET_ANGLES).len(), 1);
+    }
+
+    #[test]
+    fn replies_are_queued_whole_or_not_at_all() {
+        let mut link = HostLink::new(LinkKind::Serial);
+        let filler = [0x55; HOST_TX_CAPACITY - MAX_FRAME_BYTES + 1];
+        assert!(link.send_bytes(&filler));
+        assert!(!link.has_room_for_frame(), "a frame of any size must fit");
+        let angles = Frame::new(0x20, &[0; 12]).unwrap();
+        let room = MAX_FRAME_BYTES - 1;
+        let long = Frame::new(0x20, &[0; protocol_core::frame::MAX_DATA]).unwrap();
+        assert!(long.to_bytes().len() > room);
+        assert!(!link.send_frame(&long), "a frame that does not fit");
+        assert!(link.send_frame(&angles), "one that does");
+        let sent = drain(&mut link);
+        let (head, tail) = sent.split_at(filler.len());
+        assert_eq!(head, filler, "nothing of the refused frame");
+        assert_eq!(tail, angles.to_bytes().as_slice());
+        assert!(link.has_room_for_frame(), "empty again");
+    }
+
+    #[test]
+    fn raw_bytes_push_out_the_oldest_when_the_queue_is_full() {
+        let mut link = HostLink::new(LinkKind::Serial);
+        let bytes = (0..=HOST_TX_CAPACITY).map(|i| i as u8);
+        let kept: std::vec::Vec<bool> = bytes.clone().map(|b| link.send_raw(b)).collect();
+        assert_eq!(kept.iter().filter(|&&k| !k).count(), 1, "one byte dropped");
+        assert_eq!(kept.last(), Some(&false), "by the last one sent");
+        let expected: std::vec::Vec<u8> = bytes.skip(1).collect();
+        assert_eq!(
+            drain(&mut link),
+            expected,
+            "the oldest went, the newest stayed"
+        );
+    }
+
+    #[test]
+    fn the_port_gets_small_chunks_and_only_while_its_transmitter_is_idle() {
+        let mut link = HostLink::new(LinkKind::Serial);
+        let bytes: std::vec::Vec<u8> = (0..100).collect();
+        assert!(link.send_bytes(&bytes));
+        assert!(link.next_chunk(false).is_none(), "transmitter busy");
+        let first = link.next_chunk(true).unwrap();
+        assert_eq!(first.as_slice(), &bytes[..HOST_WRITE_CHUNK]);
+        link.clear_tx();
+        assert!(link.next_chunk(true).is_none(), "cleared");
+    }
+}

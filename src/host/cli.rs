@@ -14,8 +14,11 @@ use crate::sim::{FlashTiming, HostLink};
 #[derive(Debug, Parser)]
 #[command(version, about)]
 pub struct Cli {
-    /// Also create a symlink at PATH to the pseudo-terminal (a stale one is replaced; removed
-    /// on exit), e.g. `--pty-link /tmp/mycobot` then `MyCobot280("/tmp/mycobot")`.
+    /// Also create a symlink at PATH to the pseudo-terminal, e.g. `--pty-link /tmp/mycobot`
+    /// then `MyCobot280("/tmp/mycobot")`. While the robot runs it holds PATH.lock (with its
+    /// pid) locked, so a second robot on the same PATH refuses to start; the kernel drops the
+    /// lock when the robot ends, however it ends, and a link left by a robot that is gone is
+    /// replaced. On exit the link is removed if it still points to this robot's terminal.
     #[arg(long, value_name = "PATH")]
     pub pty_link: Option<PathBuf>,
 

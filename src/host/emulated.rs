@@ -13,6 +13,7 @@
 use std::io::{self, ErrorKind, Read, Write};
 use std::net::{SocketAddr, TcpStream};
 use std::os::fd::{AsFd, BorrowedFd};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use crate::sim::external::{BoardId, EmulatedArm};
@@ -21,6 +22,11 @@ use super::realtime::RealtimeRobot;
 
 /// How long [`Chardev::connect`] keeps trying while the emulator starts.
 pub const CONNECT_TIMEOUT: Duration = Duration::from_secs(20);
+
+/// How long one attempt to connect may take, and the pause between two: short, so a stop
+/// (Ctrl-C while the emulator starts) is seen within a fifth of a second. The emulator's
+/// sockets are on this machine, where a connection is answered at once.
+const CONNECT_ATTEMPT: Duration = Duration::from_millis(100);
 
 /// One emulated UART, reached through its socket (non-blocking).
 #[derive(Debug)]
@@ -33,16 +39,28 @@ pub struct Chardev {
 }
 
 impl Chardev {
-    /// Connects to the emulator's socket at `addr`, trying again until `timeout` passes.
-    pub fn connect(name: &'static str, addr: SocketAddr, timeout: Duration) -> io::Result<Self> {
+    /// Connects to the emulator's socket at `addr`, trying again until `timeout` passes; gives
+    /// up (`ErrorKind::Interrupted`) as soon as `stop` is set.
+    pub fn connect(
+        name: &'static str,
+        addr: SocketAddr,
+        timeout: Duration,
+        stop: &AtomicBool,
+    ) -> io::Result<Self> {
         let deadline = Instant::now() + timeout;
         let stream = loop {
-            match TcpStream::connect_timeout(&addr, Duration::from_secs(1)) {
+            if stop.load(Ordering::Relaxed) {
+                return Err(io::Error::new(
+                    ErrorKind::Interrupted,
+                    format!("stopped while waiting for the {name} at {addr}"),
+                ));
+            }
+            match TcpStream::connect_timeout(&addr, CONNECT_ATTEMPT) {
                 Ok(stream) => break stream,
                 Err(e) if Instant::now() >= deadline => {
                     return Err(io::Error::new(e.kind(), format!("{name} at {addr}: {e}")));
                 }
-                Err(_) => std::thread::sleep(Duration::from_millis(100)),
+                Err(_) => std::thread::sleep(CONNECT_ATTEMPT),
             }
         };
         stream.set_nodelay(true)?;
@@ -175,11 +193,13 @@ mod tests {
             "Atom's bus UART",
             bus_end.local_addr().unwrap(),
             CONNECT_TIMEOUT,
+            &AtomicBool::new(false),
         );
         let front = Chardev::connect(
             "Atom's host UART",
             front_end.local_addr().unwrap(),
             CONNECT_TIMEOUT,
+            &AtomicBool::new(false),
         );
         let (mut board, _) = bus_end.accept().unwrap();
         let _front_peer = front_end.accept().unwrap();
@@ -203,5 +223,29 @@ mod tests {
             assert!(t < 1_000_000, "no answer: {heard:02X?}");
         }
         assert_eq!(heard, [0xFF, 0xFF, 0x01, 0x04, 0x00, 0x00, 0x08, 0xF2]);
+    }
+
+    /// A stop while the emulator is not up yet ends the wait, long before the timeout.
+    #[test]
+    fn a_stop_ends_the_wait_for_the_emulator() {
+        let nobody = TcpListener::bind("127.0.0.1:0")
+            .unwrap()
+            .local_addr()
+            .unwrap();
+        let stop = std::sync::Arc::new(AtomicBool::new(false));
+        let signal = std::sync::Arc::clone(&stop);
+        std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_millis(100));
+            signal.store(true, Ordering::Relaxed);
+        });
+        let started = Instant::now();
+        let error =
+            Chardev::connect("Atom's bus UART", nobody, CONNECT_TIMEOUT, &stop).unwrap_err();
+        assert_eq!(error.kind(), ErrorKind::Interrupted, "{error}");
+        assert!(
+            started.elapsed() < CONNECT_TIMEOUT / 4,
+            "{:?}",
+            started.elapsed()
+        );
     }
 }

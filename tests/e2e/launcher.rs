@@ -49,7 +49,8 @@ impl Launched {
             if let Ok(Some(status)) = self.child.try_wait() {
                 return Some(status);
             }
-            thread::sleep(Duration::from_millis(20));
+            // Often enough that a test which times the exit reads it to a few milliseconds.
+            thread::sleep(Duration::from_millis(2));
         }
         let _ = self.child.kill();
         let _ = self.child.wait();
