@@ -153,8 +153,9 @@ impl HandMove {
         let duration_s = self.duration_ns as f64 / 1e9;
         let phase = std::f64::consts::PI * elapsed as f64 / self.duration_ns as f64;
         let span = self.to - self.from;
-        let position = self.from + span * (1.0 - phase.cos()) / 2.0;
-        let velocity = span * std::f64::consts::PI / 2.0 * phase.sin() / duration_s;
+        // libm, not f64::cos/sin: the same bits on every host (see sim-hw's Cargo.toml).
+        let position = self.from + span * (1.0 - libm::cos(phase)) / 2.0;
+        let velocity = span * std::f64::consts::PI / 2.0 * libm::sin(phase) / duration_s;
         (position, velocity, false)
     }
 }
@@ -1311,6 +1312,24 @@ mod tests {
         rig.run_for_ms(1_000);
         assert!(!rig.servo(0).hand_moving());
         assert!(rig.servo(0).present_position().abs_diff(held) <= 2);
+    }
+
+    #[test]
+    fn a_hand_move_follows_the_same_path_on_every_host() {
+        // 41.19 ms into a 2048 -> 2560 turn over a second: here glibc's sin on i686 is one bit
+        // off its x86_64 one, and so was the speed when the path used f64::sin. The bits are
+        // libm's; a libm upgrade that moves them by an ulp is fine, update them then.
+        // (black_box: else the compiler works the path out itself, with its own host's sin.)
+        let hand = std::hint::black_box(HandMove {
+            from: 2048.0,
+            to: 2560.0,
+            start_ns: 0,
+            duration_ns: 1_000_000_000,
+        });
+        let (position, speed, over) = hand.at(std::hint::black_box(41_190_000));
+        assert!(!over);
+        assert_eq!(position.to_bits(), 0x40a0_0447_dd81_1b1f, "{position}");
+        assert_eq!(speed.to_bits(), 0x4059_f1ff_9175_5817, "{speed}");
     }
 
     #[test]
