@@ -2,7 +2,7 @@
 //! simulated arm so that unmodified clients can drive it.
 //!
 //! * [`pty`]: a raw pseudo-terminal standing in for the Basic's USB serial port;
-//! * [`pty_link`]: a stable symlink to it (`--pty-link`);
+//! * [`pty_link`]: a stable symlink to it (`--pty-link`), held by one robot at a time;
 //! * [`tcp`]: the host protocol over TCP, like the Basic's Wi-Fi server (`--tcp`);
 //! * [`pacer`]: client input paced to the serial line's speed, as a real port does;
 //! * [`realtime`]: the loop that runs the robot at wall-clock speed and moves the bytes;
