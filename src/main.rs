@@ -111,6 +111,10 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
         robot.add_obstacle(obstacle);
         writeln!(out, "obstacle: {obstacle}")?;
     }
+    for &fault in cli.late_replies.iter().chain(&cli.lost_replies) {
+        robot.add_reply_fault(fault);
+        writeln!(out, "fault: {fault}")?;
+    }
     writeln!(out, "ready (Ctrl-C to stop)")?;
     out.flush()?;
     drop(out);
@@ -196,6 +200,10 @@ fn serve_emulated(
     for &obstacle in &cli.obstacles {
         arm.add_obstacle(obstacle);
         writeln!(out, "obstacle: {obstacle}")?;
+    }
+    for &fault in cli.late_replies.iter().chain(&cli.lost_replies) {
+        arm.add_reply_fault(fault);
+        writeln!(out, "fault: {fault}")?;
     }
     writeln!(out, "ready (Ctrl-C to stop)")?;
     out.flush()?;

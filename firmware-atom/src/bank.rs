@@ -8,9 +8,10 @@
 
 use heapless::Deque;
 use protocol_core::servo::{Packet, reg};
+use protocol_core::timing::{BUS_BAUD, wire_time_us};
 use protocol_core::units::{Centideg, Steps};
 
-use crate::config::{GRIPPER, JOINTS, SERVOS, STEPS_ZERO};
+use crate::config::{GRIPPER, JOINTS, SERVOS, STEPS_PER_TURN, STEPS_ZERO};
 use crate::driver::{Op, Outcome};
 use crate::error::AtomError;
 use crate::health::ServoHealth;
@@ -18,8 +19,11 @@ use crate::safety::{self, Goal, Goals, SafeGoals};
 use crate::settings::Settings;
 use crate::tolerance;
 
+mod profile;
 mod readback;
 
+pub use profile::Motion;
+use profile::Segment;
 use readback::{Repair, STATE_READ_ADDR, STATE_READ_LEN, apply_state, repair};
 
 /// Servo operations waiting for the bus. 24: a command queues at most 3 (EEPROM unlock,
@@ -38,12 +42,35 @@ const HOLD_SPEED_PERCENT: u8 = 10;
 /// several refresh rounds (a round takes about 3 ms).
 const GOAL_CONFIRM_US: u64 = 30_000;
 
-/// How long a stop still trusts the last state read of a servo whose reads are being lost (its
-/// answers late or garbled: a busy bus, a slow or emulated Atom): it holds torque and goes on
-/// doing what it last did, so a stop extrapolates its last read speed for up to this long.
-/// Half a second: a joint at full speed crosses 75 deg in that time, far more than the loss of
-/// a few reads costs, and an older read says nothing about where the joint is.
-const STALE_STATE_US: u64 = 500_000;
+/// How long a state reading says where its joint is: 50 ms, a dozen refresh rounds (a round
+/// takes about 4 ms, and a reply lost now and then costs one). A joint without a reading this
+/// recent (its servo's replies late or lost) is not known to be anywhere: a motion stops with
+/// [`AtomError::StateLost`], none starts, and "is moving" says yes. At full speed a joint turns
+/// 7.5 deg in this time, but not unwatched: the Atom keeps driving it along the commanded path.
+pub const FRESH_STATE_US: u64 = 50_000;
+
+/// How far a reading is carried on at its speed to say where its joint is now: 20 ms. A stop
+/// and a followed path use a reading only this recent; an older one (though fresh) says too
+/// little about a joint that may have sped up or slowed down since, so they go by what the
+/// joint was told ([`ServoBank::commanded`]).
+pub const ESTIMATE_HORIZON_US: u64 = 20_000;
+
+/// Time a reading may have waited for the Atom beyond the time between two readings (a slow
+/// loop reads its UART late), in the test of a reading against the one before: 10 ms.
+const READ_SLACK_US: u64 = 10_000;
+
+/// Steps a reading may differ from the one before beyond what the servo can turn in the time
+/// between (encoder noise, rounding): 8 steps, 0.7 deg.
+const READ_SLACK_STEPS: i64 = 8;
+
+/// A servo that stopped answering for this long (or never answered) is only probed now and
+/// then ([`LOST_SERVO_PROBE_ROUNDS`]): 1 s. Before that it is read in every round, so that a
+/// joint whose replies were lost for a moment is seen again at once.
+const LOST_SERVO_PROBE_AFTER_US: u64 = 1_000_000;
+
+/// A servo acts on a goal at its next control step (its loop runs at 1 kHz): half a
+/// millisecond after the goal arrives, on average.
+const GOAL_TAKEN_AFTER_US: u64 = 500;
 
 /// Who waits for a queued servo operation's result. Opaque to the bank: it hands the ticket
 /// back with the result ([`Finished`]), and whoever queued the operation knows what it means.
@@ -84,6 +111,18 @@ struct Servo {
     repairs: u8,
     /// When it last got a goal (it may not report moving until its next state read).
     goal_sent_us: u64,
+    /// What its own motion profile does with the last goal written to it, from the moment it
+    /// reached it ([`ServoBank::commanded`]); `None` while it is released or has not been told
+    /// anything since its torque changed.
+    profile: Option<Segment>,
+    /// False while its latest reading is not believed: it jumped further from the last believed
+    /// one than the servo can turn in the time between.
+    trusted: bool,
+    /// Its last believed reading and when it came.
+    trusted_position: Steps,
+    trusted_us: u64,
+    /// When its last state read failed.
+    missed_us: u64,
 }
 
 /// The servos' state and the Atom's instructions to them. See the [module doc](self).
@@ -98,6 +137,8 @@ pub struct ServoBank {
     jobs: Deque<Job, OP_QUEUE>,
     refresh_next: usize,
     refresh_rounds: u32,
+    /// A joint whose reading jumped, not yet taken by [`ServoBank::take_jump`].
+    jumped: Option<usize>,
 }
 
 impl ServoBank {
@@ -119,6 +160,7 @@ impl ServoBank {
             jobs: Deque::new(),
             refresh_next: 0,
             refresh_rounds: 0,
+            jumped: None,
         }
     }
 
@@ -185,74 +227,57 @@ impl ServoBank {
             .map_or(0, |h| i32::from(h.speed_steps_per_s))
     }
 
-    /// Where joint `j` is at `now_us`, in thousandths of a step: its last read position moved
-    /// on by its last read speed for the time since (the reads of a round are a few ms apart).
+    /// Where joint `j` is at `now_us` as get angles reports it, in thousandths of a step: its
+    /// last read position moved on by its last read speed for the time since, at most
+    /// [`ESTIMATE_HORIZON_US`] (the reads of a round are a few ms apart).
     pub fn estimated_millisteps(&self, now_us: u64, j: usize) -> i64 {
-        self.extrapolated_millisteps(now_us, j, self.velocity(j), 20_000)
+        let position = self.health(j).map_or(0, |h| i64::from(h.position.0));
+        let age_us = self.read_age_us(now_us, j).min(ESTIMATE_HORIZON_US) as i64;
+        position * 1000 + i64::from(self.velocity(j)) * age_us / 1000
     }
 
-    /// Servo `index`'s last read position moved on at `speed` steps/s for the time since that
-    /// read, at most `max_age_us`, in thousandths of a step.
-    fn extrapolated_millisteps(
-        &self,
-        now_us: u64,
-        index: usize,
-        speed: i32,
-        max_age_us: u64,
-    ) -> i64 {
-        let position = self.health(index).map_or(0, |h| i64::from(h.position.0));
-        let age_us = self.read_age_us(now_us, index).min(max_age_us) as i64;
-        position * 1000 + i64::from(speed) * age_us / 1000
-    }
-
-    /// True if servo `index` holds torque as far as the Atom knows and its position was read at
-    /// least once, whether or not its latest reads came back: what a stop must brake. A servo
-    /// whose answers are lost still hears the goals (a SYNC WRITE has no answer), and it goes
-    /// on towards its last goal until it gets another one.
-    pub fn holds_torque(&self, index: usize) -> bool {
-        self.health(index)
-            .is_some_and(|h| h.ever_answered && h.torque_on)
-    }
-
-    /// Servo `index`'s speed at `now_us` as a stop must assume it, steps per second: its last
-    /// read speed while it answers ([`Self::velocity`]), and also while its reads are being
-    /// lost, as long as its last read is at most [`STALE_STATE_US`] old and it holds torque (it
-    /// goes on doing what it did); 0 otherwise.
-    pub fn last_known_velocity(&self, now_us: u64, index: usize) -> i32 {
-        let Some(h) = self.health(index) else {
-            return 0;
+    /// What servo `index`'s latest reading says about it now, if that reading is believed and
+    /// at most [`ESTIMATE_HORIZON_US`] old: its position moved on by its read speed for the
+    /// whole time since, and that speed. `None` for an older, missing or jumped reading: a
+    /// goal is never made from one.
+    pub fn observed(&self, now_us: u64, index: usize) -> Option<Motion> {
+        let s = self.servos.get(index)?;
+        let h = &s.health;
+        let age_us = self.trusted_age_us(now_us, index)?;
+        if age_us > ESTIMATE_HORIZON_US {
+            return None;
+        }
+        let speed = if h.torque_on {
+            i64::from(h.speed_steps_per_s)
+        } else {
+            0
         };
-        if h.answering {
-            return self.velocity(index);
-        }
-        if !self.holds_torque(index) || self.read_age_us(now_us, index) > STALE_STATE_US {
-            return 0;
-        }
-        i32::from(h.speed_steps_per_s)
+        Some(Motion {
+            millisteps: i64::from(h.position.0) * 1000 + speed * age_us as i64 / 1000,
+            millisteps_per_s: speed * 1000,
+        })
     }
 
-    /// Where servo `index` is at `now_us` as a stop must assume it, in thousandths of a step:
-    /// the estimate of [`Self::estimated_millisteps`] while it answers; while its reads are
-    /// being lost, its last read position moved on by [`Self::last_known_velocity`] for the
-    /// whole time since (up to [`STALE_STATE_US`]), but never past its last goal (a servo stops
-    /// there).
-    pub fn last_known_millisteps(&self, now_us: u64, index: usize) -> i64 {
-        let Some(h) = self.health(index) else {
-            return 0;
-        };
-        if h.answering {
-            return self.estimated_millisteps(now_us, index);
-        }
-        let read = i64::from(h.position.0) * 1000;
-        let speed = self.last_known_velocity(now_us, index);
-        let moved = self.extrapolated_millisteps(now_us, index, speed, STALE_STATE_US);
-        match self.last_goal(index) {
-            Some(goal) => {
-                let goal = i64::from(goal.position.0) * 1000;
-                moved.clamp(read.min(goal), read.max(goal))
-            }
-            None => read,
-        }
+    /// What servo `index` was told, worked out for `now_us`: where its own motion profile has
+    /// carried its setpoint with the last goal written to it, and how fast it moves
+    /// ([`profile`]). `None` while it holds no goal the Atom wrote since its torque changed.
+    pub fn commanded(&self, now_us: u64, index: usize) -> Option<Motion> {
+        let s = self.servos.get(index)?;
+        s.profile.map(|p| p.at(now_us))
+    }
+
+    /// Servo `index`'s motion at `now_us` as a goal may be made from it: what it was told
+    /// ([`Self::commanded`]), else its recent reading ([`Self::observed`]), else at rest on its
+    /// last goal; `None` if none of them is known.
+    pub fn motion(&self, now_us: u64, index: usize) -> Option<Motion> {
+        self.commanded(now_us, index)
+            .or_else(|| self.observed(now_us, index))
+            .or_else(|| {
+                self.last_goal(index).map(|g| Motion {
+                    millisteps: i64::from(g.position.0) * 1000,
+                    millisteps_per_s: 0,
+                })
+            })
     }
 
     /// When servo `index`'s last state read arrived (monotonic microseconds); `None` before
@@ -269,17 +294,59 @@ impl ServoBank {
         now_us.saturating_sub(self.servos.get(index).map_or(0, |s| s.read_us))
     }
 
-    /// True at `now_us` while a joint that answers reports moving, or one whose latest reads
-    /// were lost reported moving at its last read (up to [`STALE_STATE_US`] ago, holding
-    /// torque): it is most likely still moving, and "is moving" must not say no while it
-    /// brakes.
+    /// Time from servo `index`'s last believed state read to `now_us`; `None` if it was never
+    /// read or its latest reading jumped.
+    fn trusted_age_us(&self, now_us: u64, index: usize) -> Option<u64> {
+        let s = self.servos.get(index)?;
+        (s.health.ever_answered && s.trusted).then(|| now_us.saturating_sub(s.read_us))
+    }
+
+    /// True if servo `index` has a believed reading at most [`FRESH_STATE_US`] old at
+    /// `now_us`: the Atom knows where it is.
+    pub fn fresh(&self, now_us: u64, index: usize) -> bool {
+        self.trusted_age_us(now_us, index)
+            .is_some_and(|age| age <= FRESH_STATE_US)
+    }
+
+    /// The first joint without a fresh reading at `now_us` ([`Self::fresh`]), if any.
+    pub fn unknown_joint(&self, now_us: u64) -> Option<usize> {
+        (0..JOINTS).find(|&j| !self.fresh(now_us, j))
+    }
+
+    /// Takes the joint whose reading last jumped (further from the one before than its servo
+    /// can turn in the time between), if one did since the last call.
+    pub fn take_jump(&mut self) -> Option<usize> {
+        self.jumped.take()
+    }
+
+    /// True if servo `index` holds torque as far as the Atom knows and its position was read at
+    /// least once, whether or not its latest reads came back: what a stop must brake. A servo
+    /// whose answers are lost still hears the goals (a SYNC WRITE has no answer), and it goes
+    /// on towards its last goal until it gets another one.
+    pub fn holds_torque(&self, index: usize) -> bool {
+        self.health(index)
+            .is_some_and(|h| h.ever_answered && h.torque_on)
+    }
+
+    /// True if joint `j`'s latest fresh reading says it is at rest on its goal at `now_us`:
+    /// not moving, and within [`tolerance::IN_POSITION_STEPS`] of the goal it was last sent
+    /// (if it holds one). A joint without a fresh reading is not known to be at rest.
+    fn settled(&self, now_us: u64, j: usize) -> bool {
+        let Some(s) = self.servos.get(j) else {
+            return false;
+        };
+        let on_goal = s
+            .last_goal
+            .is_none_or(|g| tolerance::servo_at(g.position, s.health.position));
+        self.fresh(now_us, j) && !s.health.moving && on_goal
+    }
+
+    /// True at `now_us` unless every joint's latest fresh reading says it is at rest on its
+    /// goal ([`Self::settled`]): a joint that moves, one not yet on its goal (a goal sent
+    /// moments ago is not "at rest" before the servo starts), and one whose readings stopped
+    /// or jumped all count as moving.
     pub fn joints_moving(&self, now_us: u64) -> bool {
-        self.servos.iter().take(JOINTS).enumerate().any(|(j, s)| {
-            let h = &s.health;
-            h.moving
-                && (h.answering
-                    || (self.holds_torque(j) && self.read_age_us(now_us, j) <= STALE_STATE_US))
-        })
+        (0..JOINTS).any(|j| !self.settled(now_us, j))
     }
 
     /// True at `now_us` while servo `index` moves: its moving flag, or a goal sent moments ago
@@ -417,6 +484,8 @@ impl ServoBank {
             if queued {
                 s.health.torque_on = on;
                 s.repairs = 0;
+                // Switched on, it holds where its shaft is: its old profile is gone.
+                s.profile = None;
             }
         }
         queued
@@ -459,6 +528,7 @@ impl ServoBank {
     pub fn calibrated(&mut self, index: usize) {
         if let Some(s) = self.servos.get_mut(index) {
             s.health.position = Steps(STEPS_ZERO as i16);
+            s.trusted_position = s.health.position;
         }
         self.forget_goal(index);
     }
@@ -468,6 +538,7 @@ impl ServoBank {
     fn forget_goal(&mut self, index: usize) {
         if let Some(s) = self.servos.get_mut(index) {
             s.last_goal = None;
+            s.profile = None;
         }
         self.pending = self.pending.take().map(|p| p.without(index));
     }
@@ -504,12 +575,45 @@ impl ServoBank {
         self.jobs.front().map(|j| j.op.clone())
     }
 
-    /// The SYNC WRITE of the goals not written yet, taking them.
-    pub fn take_goal_write(&mut self, settings: &Settings) -> Option<Op> {
+    /// The SYNC WRITE of the goals not written yet, taking them, to be sent at `now_us`: each
+    /// servo's profile continues with its new goal from the moment the write reaches it
+    /// ([`Self::commanded`]).
+    pub fn take_goal_write(&mut self, now_us: u64, settings: &Settings) -> Option<Op> {
         let goals = self.pending.take()?;
-        goals
-            .sync_write(&settings.config().servo_ids)
-            .map(Op::Broadcast)
+        let packet = goals.sync_write(&settings.config().servo_ids)?;
+        let arrives_us =
+            now_us + wire_time_us(packet.to_bytes().len() as u32, BUS_BAUD) + GOAL_TAKEN_AFTER_US;
+        for (i, goal) in goals.goals().iter() {
+            self.follow_goal(arrives_us, settings, i, goal);
+        }
+        Some(Op::Broadcast(packet))
+    }
+
+    /// Notes that servo `index`'s profile takes `goal` from `at_us` on, continuing from where
+    /// it was carrying the setpoint then (from its latest reading if the Atom had told it
+    /// nothing it can work out).
+    fn follow_goal(&mut self, at_us: u64, settings: &Settings, index: usize, goal: Goal) {
+        let Some(from) = self.motion(at_us, index) else {
+            return;
+        };
+        let motion = &settings.config().motion;
+        let speed = match goal.speed_steps_per_s {
+            0 => motion.servo_speed_max_steps_per_s,
+            v => u32::from(v).min(motion.servo_speed_max_steps_per_s),
+        };
+        let accel = match goal.accel {
+            0 => motion.servo_accel_steps_per_s2,
+            a => (u32::from(a) * 100).min(motion.servo_accel_steps_per_s2),
+        };
+        if let Some(s) = self.servos.get_mut(index) {
+            s.profile = Some(Segment {
+                start_us: at_us,
+                from,
+                goal_millisteps: i64::from(goal.position.0) * 1000,
+                speed_millisteps_per_s: i64::from(speed) * 1000,
+                accel_millisteps_per_s2: i64::from(accel) * 1000,
+            });
+        }
     }
 
     /// The state read of the next servo in the refresh round (lost servos only now and then).
@@ -524,7 +628,8 @@ impl ServoBank {
             }
             let lost = self
                 .health(index)
-                .is_some_and(|h| !h.answering && h.misses >= config.timing.misses_before_lost);
+                .is_some_and(|h| !h.answering && h.misses >= config.timing.misses_before_lost)
+                && self.lost_for_long(index);
             if lost && !self.refresh_rounds.is_multiple_of(LOST_SERVO_PROBE_ROUNDS) {
                 continue;
             }
@@ -536,6 +641,15 @@ impl ServoBank {
             });
         }
         None
+    }
+
+    /// True if servo `index` never answered, or has not for [`LOST_SERVO_PROBE_AFTER_US`]
+    /// (measured at its last failed read): a missing servo, not a reply lost for a moment.
+    fn lost_for_long(&self, index: usize) -> bool {
+        self.servos.get(index).is_none_or(|s| {
+            !s.health.ever_answered
+                || s.missed_us.saturating_sub(s.read_us) >= LOST_SERVO_PROBE_AFTER_US
+        })
     }
 
     /// Completed state-refresh rounds (every servo read once per round). Wraps.
@@ -573,12 +687,21 @@ impl ServoBank {
                     let first = !s.health.ever_answered;
                     apply_state(&mut s.health, p);
                     s.read_us = now_us;
+                    let speed_max = i64::from(config.motion.servo_speed_max_steps_per_s);
+                    s.trusted = first || believable(s, now_us, speed_max);
+                    if s.trusted {
+                        s.trusted_position = s.health.position;
+                        s.trusted_us = now_us;
+                    } else if i < JOINTS {
+                        self.jumped = Some(i);
+                    }
                     if first {
-                        self.adopt(i, p);
+                        self.adopt(now_us, i, p);
                     }
                     self.verify(settings, i);
                 }
                 _ => {
+                    s.missed_us = now_us;
                     let h = &mut s.health;
                     h.comm_errors = h.comm_errors.wrapping_add(1);
                     h.corrupt_answers = corrupt;
@@ -623,7 +746,7 @@ impl ServoBank {
     /// has not told it anything yet: a servo that holds torque keeps its goal (the Atom
     /// restarted while the arm was on: the arm stays powered, a move in progress finishes,
     /// nothing goes limp or stops), a released one stays released.
-    fn adopt(&mut self, index: usize, packet: &Packet) {
+    fn adopt(&mut self, now_us: u64, index: usize, packet: &Packet) {
         let Some(s) = self.servos.get_mut(index) else {
             return;
         };
@@ -639,10 +762,22 @@ impl ServoBank {
             .get(at(reg::ACCELERATION))
             .copied()
             .unwrap_or(0);
-        s.last_goal = Some(Goal {
+        let goal = Goal {
             position: s.health.goal_reported,
             speed_steps_per_s: speed.max(1),
             accel: accel.max(1),
+        };
+        s.last_goal = Some(goal);
+        // What its profile does with that goal, from where it is and how fast it moves.
+        s.profile = Some(Segment {
+            start_us: now_us,
+            from: Motion {
+                millisteps: i64::from(s.health.position.0) * 1000,
+                millisteps_per_s: i64::from(s.health.speed_steps_per_s) * 1000,
+            },
+            goal_millisteps: i64::from(goal.position.0) * 1000,
+            speed_millisteps_per_s: i64::from(goal.speed_steps_per_s) * 1000,
+            accel_millisteps_per_s2: i64::from(goal.accel) * 100_000,
         });
     }
 
@@ -650,6 +785,23 @@ impl ServoBank {
     pub fn gripper_position(&self) -> Steps {
         self.health(GRIPPER).map(|h| h.position).unwrap_or_default()
     }
+}
+
+/// True if `s`'s latest reading (at `now_us`) is one its servo could have made: no further from
+/// the last believed one than the shaft turns at `speed_max` steps/s in the time between (plus
+/// [`READ_SLACK_US`] for a reading that waited, and [`READ_SLACK_STEPS`]), across the encoder's
+/// wrap. A released servo's shaft is turned by hand, however fast: always believed.
+fn believable(s: &Servo, now_us: u64, speed_max: i64) -> bool {
+    let h = &s.health;
+    if !(h.torque_on && h.torque_reported) {
+        return true;
+    }
+    let turn = i64::from(STEPS_PER_TURN);
+    let d = (i64::from(h.position.0) - i64::from(s.trusted_position.0)).rem_euclid(turn);
+    let moved = d.min(turn - d);
+    let elapsed_us = now_us.saturating_sub(s.trusted_us) + READ_SLACK_US;
+    let reach = speed_max.saturating_mul(elapsed_us.min(10_000_000) as i64) / 1_000_000;
+    moved <= reach + READ_SLACK_STEPS
 }
 
 /// Servo state reads and banks that have read them, for the unit tests of the parts that act
@@ -718,6 +870,22 @@ pub(crate) mod test_support {
         );
     }
 
+    /// Servo `index`'s state read at `now_us` gets no answer (timed out), `times` times.
+    pub fn miss(bank: &mut ServoBank, settings: &Settings, now_us: u64, index: usize, times: u8) {
+        let id = settings.config().servo_ids[index];
+        for _ in 0..times {
+            let op = Op::Read {
+                id,
+                addr: STATE_READ_ADDR,
+                count: STATE_READ_LEN,
+            };
+            assert_eq!(
+                bank.finish(now_us, settings, op, Outcome::TimedOut, false),
+                None
+            );
+        }
+    }
+
     /// A bank that read every servo at `now_us`: joint `j` at `positions[j]` moving at
     /// `speeds[j]` steps/s toward a goal far ahead (at rest: its goal is where it is), the
     /// gripper at 2048.
@@ -747,6 +915,17 @@ pub(crate) mod test_support {
         bank
     }
 
+    /// Reads every servo of `bank` again at `now_us`, at rest where it was last read, its goal
+    /// register the goal it was last sent: time passed, nothing moved and no write was lost.
+    pub fn reread(bank: &mut ServoBank, settings: &Settings, now_us: u64) {
+        for i in 0..SERVOS {
+            let position = bank.health(i).map_or(2048, |h| h.position.0);
+            let goal = bank.last_goal(i).map_or(position, |g| g.position.0);
+            let id = settings.config().servo_ids[i];
+            read(bank, settings, now_us, i, state(id, position, 0, goal));
+        }
+    }
+
     /// A powered arm ([`powered`]) whose bank read every servo at rest at 2048 (every joint
     /// at 0 deg) at time 0.
     pub fn at_rest() -> (Settings, ServoBank) {
@@ -770,7 +949,7 @@ pub(crate) mod test_support {
 mod tests {
     use protocol_core::servo::Packet;
 
-    use super::test_support::{at_rest, bank_read, powered, read, state};
+    use super::test_support::{at_rest, bank_read, powered, read, reread, state};
     use super::*;
     use crate::driver::Op;
 
@@ -791,12 +970,12 @@ mod tests {
             .unwrap();
         bank.send_goals(30, &settings, Goals::one(0, goal(2150)))
             .unwrap();
-        let Some(Op::Broadcast(write)) = bank.take_goal_write(&settings) else {
+        let Some(Op::Broadcast(write)) = bank.take_goal_write(0, &settings) else {
             panic!("one SYNC WRITE");
         };
         // Two servos' move blocks (id + 7 bytes each) after the address and length.
         assert_eq!(write.params().len(), 2 + 2 * 8);
-        assert_eq!(bank.take_goal_write(&settings), None, "taken");
+        assert_eq!(bank.take_goal_write(0, &settings), None, "taken");
         assert_eq!(
             bank.last_goal(0),
             Some(goal(2150)),
@@ -818,7 +997,7 @@ mod tests {
             bank.send_goals(0, &settings, Goals::one(0, goal(2100))),
             Err(AtomError::PoweredOff)
         );
-        assert_eq!(bank.take_goal_write(&settings), None);
+        assert_eq!(bank.take_goal_write(0, &settings), None);
     }
 
     #[test]
@@ -826,23 +1005,23 @@ mod tests {
         let (settings, mut bank) = at_rest();
         bank.send_goals(0, &settings, Goals::one(0, goal(2300)))
             .unwrap();
-        assert!(bank.take_goal_write(&settings).is_some());
+        assert!(bank.take_goal_write(0, &settings).is_some());
         for repair in 0..readback::MAX_REPAIRS {
             // The servo reports its old goal: the SYNC WRITE did not arrive.
             read(&mut bank, &settings, 1_000, 0, state(1, 2048, 0, 2048));
             assert!(
-                bank.take_goal_write(&settings).is_some(),
+                bank.take_goal_write(0, &settings).is_some(),
                 "repair {repair} re-sends the goal"
             );
         }
         read(&mut bank, &settings, 1_000, 0, state(1, 2048, 0, 2048));
-        assert_eq!(bank.take_goal_write(&settings), None, "given up");
+        assert_eq!(bank.take_goal_write(0, &settings), None, "given up");
         // A goal that arrived needs no repair.
         bank.send_goals(0, &settings, Goals::one(0, goal(2400)))
             .unwrap();
-        assert!(bank.take_goal_write(&settings).is_some());
+        assert!(bank.take_goal_write(0, &settings).is_some());
         read(&mut bank, &settings, 2_000, 0, state(1, 2048, 100, 2400));
-        assert_eq!(bank.take_goal_write(&settings), None);
+        assert_eq!(bank.take_goal_write(0, &settings), None);
     }
 
     #[test]
@@ -906,23 +1085,127 @@ mod tests {
     fn a_servo_that_misses_reads_is_lost_and_probed_only_now_and_then() {
         let (settings, mut bank) = at_rest();
         let misses = settings.config().timing.misses_before_lost;
-        for _ in 0..misses {
-            // One round: the gripper (index 6) times out every time.
-            for i in 0..SERVOS {
+        // One round at `now_us`: the servo at index `silent` times out.
+        let round = |bank: &mut ServoBank, now_us: u64, silent: usize| {
+            for _ in 0..SERVOS {
                 let op = bank.next_refresh_op(&settings).unwrap();
-                let outcome = if i == GRIPPER {
+                let i = settings
+                    .config()
+                    .servo_ids
+                    .iter()
+                    .position(|&id| id == op.id());
+                let outcome = if i == Some(silent) {
                     Outcome::TimedOut
                 } else {
                     Outcome::Answered(state(op.id(), 2048, 0, 2048))
                 };
-                bank.finish(0, &settings, op, outcome, false);
+                bank.finish(now_us, &settings, op, outcome, false);
             }
+        };
+        let probes_in_six_rounds = |bank: &mut ServoBank, id: u8| {
+            let ids: heapless::Vec<u8, 64> = (0..6 * 7)
+                .map(|_| bank.next_refresh_op(&settings).unwrap().id())
+                .collect();
+            ids.iter().filter(|&&i| i == id).count()
+        };
+        // Joint 2's replies lost for a moment: it is read in every round, to be seen again.
+        for _ in 0..misses {
+            round(&mut bank, 4_000, 1);
+        }
+        assert!(!bank.health(1).unwrap().answering);
+        assert_eq!(probes_in_six_rounds(&mut bank, 2), 6);
+        // The gripper silent for over a second: probed only now and then.
+        for k in 0..misses {
+            round(&mut bank, 1_500_000 + u64::from(k), GRIPPER);
         }
         assert!(!bank.health(GRIPPER).unwrap().answering);
-        let ids: heapless::Vec<u8, 64> = (0..6 * 7)
-            .map(|_| bank.next_refresh_op(&settings).unwrap().id())
-            .collect();
-        let probes = ids.iter().filter(|&&id| id == 7).count();
-        assert!(probes <= 1, "{ids:?}");
+        assert!(probes_in_six_rounds(&mut bank, 7) <= 1);
+    }
+
+    #[test]
+    fn a_reading_the_servo_cannot_have_made_is_not_believed() {
+        let (settings, mut bank) = at_rest();
+        assert!(bank.fresh(0, 0));
+        // 4.4 ms later joint 1 reads 40 steps on: a servo turns that far.
+        read(&mut bank, &settings, 4_400, 0, state(1, 2_088, 900, 2_500));
+        assert!(bank.fresh(4_400, 0));
+        assert_eq!(bank.take_jump(), None);
+        // Then 0 (a reply with nothing in it): half a turn in 4.4 ms is not a reading.
+        read(&mut bank, &settings, 8_800, 0, state(1, 0, 0, 2_500));
+        assert_eq!(bank.take_jump(), Some(0));
+        assert_eq!(bank.take_jump(), None, "taken once");
+        assert!(!bank.fresh(8_800, 0), "not believed");
+        assert_eq!(bank.unknown_joint(8_800), Some(0));
+        assert_eq!(bank.observed(8_800, 0), None, "no goal is made from it");
+        assert!(bank.joints_moving(8_800));
+        // The next reading consistent with the last believed one is believed again.
+        read(&mut bank, &settings, 13_200, 0, state(1, 2_120, 700, 2_500));
+        assert!(bank.fresh(13_200, 0));
+        // Across the encoder's wrap a step is a step.
+        let mut bank = bank_read(
+            &settings,
+            0,
+            [2048, 2048, 2048, 2048, 2048, 4095],
+            [0; JOINTS],
+        );
+        read(&mut bank, &settings, 1_000, 5, state(6, 1, 0, 1));
+        assert_eq!(bank.take_jump(), None);
+    }
+
+    #[test]
+    fn a_joint_is_known_only_while_its_readings_are_fresh() {
+        let (settings, mut bank) = at_rest();
+        assert!(
+            !bank.joints_moving(FRESH_STATE_US),
+            "every joint at rest on its reading"
+        );
+        assert_eq!(bank.unknown_joint(FRESH_STATE_US), None);
+        // 50 ms and a bit without a reading: nobody knows where the arm is.
+        assert_eq!(bank.unknown_joint(FRESH_STATE_US + 1), Some(0));
+        assert!(bank.joints_moving(FRESH_STATE_US + 1), "is moving says yes");
+        assert_eq!(bank.observed(ESTIMATE_HORIZON_US + 1, 0), None);
+        // All but joint 4 read again: joint 4 is the one unknown.
+        for i in (0..SERVOS).filter(|&i| i != 3) {
+            let id = settings.config().servo_ids[i];
+            read(&mut bank, &settings, 60_000, i, state(id, 2048, 0, 2048));
+        }
+        assert_eq!(bank.unknown_joint(60_000), Some(3));
+        assert!(bank.joints_moving(60_000));
+        // A goal sent but not reached yet: not at rest on it.
+        reread(&mut bank, &settings, 70_000);
+        assert!(!bank.joints_moving(70_000));
+        bank.send_goals(70_000, &settings, Goals::one(0, goal(2_300)))
+            .unwrap();
+        assert!(bank.joints_moving(70_000));
+    }
+
+    #[test]
+    fn a_written_goal_is_followed_by_the_servos_profile() {
+        let (settings, mut bank) = at_rest();
+        let holding = Motion {
+            millisteps: 2_048_000,
+            millisteps_per_s: 0,
+        };
+        assert_eq!(
+            bank.commanded(0, 0),
+            Some(holding),
+            "the goal it held, taken over"
+        );
+        bank.send_goals(0, &settings, Goals::one(0, goal(2_300)))
+            .unwrap();
+        assert_eq!(bank.commanded(0, 0), Some(holding), "not written yet");
+        assert!(bank.take_goal_write(1_000, &settings).is_some());
+        // 500 steps/s at 2000 steps/s^2: 0.25 s to full speed, 62.5 steps; the write takes
+        // a few hundred microseconds on the wire, and the servo acts on it at its next control
+        // step.
+        let m = bank.commanded(1_000 + 250_000 + 1_000, 0).unwrap();
+        assert!((m.millisteps - 2_110_500).abs() < 1_500, "{m:?}");
+        assert_eq!(m.millisteps_per_s, 500_000);
+        let end = bank.commanded(2_000_000, 0).unwrap();
+        assert_eq!(end.millisteps, 2_300_000, "on its goal");
+        assert_eq!(end.millisteps_per_s, 0);
+        // Released, it holds no goal: nothing to work out.
+        assert!(bank.set_torque(&settings, 0, false));
+        assert_eq!(bank.commanded(2_000_000, 0), None);
     }
 }

@@ -628,7 +628,7 @@ fn dir(d: Direction) -> JogDirection {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bank::test_support::powered;
+    use crate::bank::test_support::{at_rest, powered};
     use crate::config::AtomConfig;
     use crate::io::RecordingIo;
     use crate::settings::Settings;
@@ -648,9 +648,17 @@ mod tests {
         ask(parts, cmd::SEND_ANGLE, &data)
     }
 
+    /// The parts of a powered arm whose servos were all read at time 0, at rest at 0 deg.
+    fn read_arm() -> Parts {
+        let (settings, bank) = at_rest();
+        let mut parts = Parts::new(settings);
+        parts.bank = bank;
+        parts
+    }
+
     #[test]
     fn a_refused_motion_answers_00_and_records_its_code_for_0x07() {
-        let mut parts = Parts::new(powered());
+        let mut parts = read_arm();
         assert_eq!(
             send_angle_1(&mut parts, 170),
             Some(std::vec![0]),
@@ -675,10 +683,10 @@ mod tests {
 
     #[test]
     fn an_accepted_motion_becomes_goals_for_the_servos() {
-        let mut parts = Parts::new(powered());
+        let mut parts = read_arm();
         assert_eq!(send_angle_1(&mut parts, 10), Some(std::vec![1]));
         assert!(parts.motion.is_active());
-        assert!(parts.bank.take_goal_write(&parts.settings).is_some());
+        assert!(parts.bank.take_goal_write(0, &parts.settings).is_some());
     }
 
     #[test]

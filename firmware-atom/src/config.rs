@@ -90,6 +90,11 @@ pub struct MotionLimits {
     /// what measured STS3215 models reach with the myCobot's position gains (`docs/motion.md`),
     /// so a braking joint never overshoots the point it is told to stop at.
     pub servo_accel_steps_per_s2: u32,
+    /// The fastest a joint servo's shaft can turn, steps per second: 3 400 (about 300 deg/s,
+    /// above the STS3215's 270 deg/s at 12 V). What a goal speed of 0 means, and how far a
+    /// joint can have turned between two state reads: a reading further from the last one is
+    /// not believed (`bank::readback`).
+    pub servo_speed_max_steps_per_s: u32,
 }
 
 impl Default for MotionLimits {
@@ -101,6 +106,7 @@ impl Default for MotionLimits {
             rotation_speed_centideg_per_s: 9_000,
             linear_accel_decimm_per_s2: 5_000,
             servo_accel_steps_per_s2: 11_400,
+            servo_speed_max_steps_per_s: 3_400,
         }
     }
 }

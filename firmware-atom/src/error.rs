@@ -28,12 +28,18 @@ pub enum AtomError {
     Invalid,
     /// A collision stopped the arm ([`crate::collision`]); motion is refused until cleared.
     Collision(Kind),
+    /// Joint `index` (0-based) has no trustworthy state reading: its servo's replies stopped
+    /// coming for longer than [`crate::bank::FRESH_STATE_US`], or its last reading jumped
+    /// further than the servo can turn in the time since the one before. The motion stopped
+    /// (or did not start) rather than guess where the joint is.
+    StateLost(usize),
 }
 
 impl AtomError {
     /// The error code 0x07 reports for this failure (`docs/protocol.md` section 7), if it has one:
-    /// 1..=6 joint limit, 16..=18 a collision ([`Kind::code`]), 32 unreachable pose, 33 / 34 no continuous path (or an arc without a
-    /// circle, 33).
+    /// 1..=6 joint limit, 16..=18 a collision ([`Kind::code`]), 21..=26 a joint's state
+    /// readings stopped or jumped (20 + the joint number), 32 unreachable pose, 33 / 34 no
+    /// continuous path (or an arc without a circle, 33).
     pub fn error_code(self) -> Option<ErrorCode> {
         match self {
             Self::JointLimit(j) => u8::try_from(j + 1)
@@ -43,6 +49,10 @@ impl AtomError {
             Self::Unreachable => Some(ErrorCode::IkNoSolution),
             Self::Path(e) => ErrorCode::from_code(e.protocol_code()),
             Self::Collision(kind) => ErrorCode::from_code(kind.code()),
+            Self::StateLost(j) => u8::try_from(j + 1)
+                .ok()
+                .and_then(JointId::new)
+                .map(ErrorCode::StateLost),
             Self::PoweredOff | Self::GripperRange | Self::Busy | Self::Invalid => None,
         }
     }
@@ -108,6 +118,11 @@ mod tests {
             Some(6)
         );
         assert_eq!(AtomError::JointLimit(6).error_code(), None);
+        assert_eq!(
+            AtomError::StateLost(1).error_code().map(ErrorCode::code),
+            Some(22)
+        );
+        assert_eq!(AtomError::StateLost(6).error_code(), None);
         assert_eq!(
             AtomError::Unreachable.error_code().map(ErrorCode::code),
             Some(32)

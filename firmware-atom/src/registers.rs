@@ -31,7 +31,7 @@ use crate::context::Context;
 use crate::driver::Op;
 use crate::error::AtomError;
 use crate::gripper::{self, Gripper};
-use crate::motion::MotionController;
+use crate::motion::{self, MotionController};
 use crate::safety::{Goal, Goals};
 use crate::settings::Settings;
 
@@ -147,14 +147,17 @@ pub fn calibrate(
     Ok(())
 }
 
-/// Joint brake (0x55): the servo holds where it is.
+/// Joint brake (0x55): the servo stops where it comes to rest braking at full deceleration
+/// ([`motion::stop_one`]: from what it was told, never from an old reading, which would turn a
+/// moving joint back); a released servo stays released.
 pub fn brake(cx: &mut Context<'_>, index: usize) -> Result<(), AtomError> {
-    let steps = cx
-        .bank
-        .health(index)
-        .map(|h| h.position)
-        .ok_or(AtomError::Invalid)?;
-    move_to_steps(cx, index, steps)
+    if cx.settings.config().servo_ids.get(index).is_none() {
+        return Err(AtomError::Invalid);
+    }
+    match motion::stop_one(cx, index) {
+        Some(goal) => cx.send_goals(Goals::one(index, goal)),
+        None => Ok(()),
+    }
 }
 
 /// Moves servo `index` to an encoder position at the default speed.

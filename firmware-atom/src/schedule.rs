@@ -210,7 +210,7 @@ impl BusSchedule {
         } else if let Some(op) = bank.due_job() {
             self.owe_refresh = true;
             Some(op)
-        } else if let Some(op) = bank.take_goal_write(settings) {
+        } else if let Some(op) = bank.take_goal_write(now_us, settings) {
             self.owe_refresh = true;
             Some(op)
         } else {

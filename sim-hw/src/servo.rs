@@ -102,6 +102,15 @@ pub struct Faults {
     pub stall: bool,
     /// The servo is too hot: high temperature and the overheat bit.
     pub overheat: bool,
+    /// Every answer starts this many microseconds later than the servo's return delay says (a
+    /// slow servo, or a controller that reads its UART late): past the Atom's deadline from
+    /// about 200 us on. A late answer still goes on the wire when its time comes, whether or
+    /// not the controller is still waiting for it, and garbles whatever else is on the wire
+    /// then.
+    pub reply_delay_us: u32,
+    /// Of every thousand answers, this many are never sent (lost on the way), spread evenly
+    /// and deterministically: at 100 every tenth answer, at 500 every other one.
+    pub dropped_per_mille: u16,
 }
 
 impl Faults {
@@ -111,6 +120,8 @@ impl Faults {
         bad_checksum: false,
         stall: false,
         overheat: false,
+        reply_delay_us: 0,
+        dropped_per_mille: 0,
     };
     /// Only [`Faults::no_answer`].
     pub const NO_ANSWER: Self = Self {
@@ -132,6 +143,22 @@ impl Faults {
         overheat: true,
         ..Self::NONE
     };
+
+    /// Only [`Faults::reply_delay_us`]: every answer `delay_us` late.
+    pub const fn late_replies(delay_us: u32) -> Self {
+        Self {
+            reply_delay_us: delay_us,
+            ..Self::NONE
+        }
+    }
+
+    /// Only [`Faults::dropped_per_mille`]: `per_mille` of every thousand answers lost.
+    pub const fn dropped_replies(per_mille: u16) -> Self {
+        Self {
+            dropped_per_mille: per_mille,
+            ..Self::NONE
+        }
+    }
 }
 
 /// A hand turning a released shaft: raw positions (steps) over time.
@@ -272,6 +299,10 @@ pub struct SimServo {
     hand: Option<HandMove>,
     /// Writes still to miss ([`SimServo::lose_next_writes`]).
     writes_to_lose: u32,
+    /// Answers still to drop ([`SimServo::drop_next_answers`]).
+    answers_to_drop: u32,
+    /// Spreads [`Faults::dropped_per_mille`] evenly: thousandths of an answer owed to the loss.
+    drop_debt: u32,
     stats: ServoStats,
 }
 
@@ -300,6 +331,8 @@ impl SimServo {
             answers_to_corrupt: 0,
             hand: None,
             writes_to_lose: 0,
+            answers_to_drop: 0,
+            drop_debt: 0,
             stats: ServoStats::default(),
         };
         servo.factory_reset(id);
@@ -436,6 +469,12 @@ impl SimServo {
     /// transient disturbance of its replies (for a permanent one use [`Faults::bad_checksum`]).
     pub fn corrupt_next_answers(&mut self, count: u32) {
         self.answers_to_corrupt = count;
+    }
+
+    /// Never sends its next `count` answers (lost on the way), then answers again: a transient
+    /// loss of its replies (for a lasting one use [`Faults::dropped_per_mille`]).
+    pub fn drop_next_answers(&mut self, count: u32) {
+        self.answers_to_drop = count;
     }
 
     /// Misses the next `count` write instructions addressed to it (WRITE, REG WRITE, or its part
@@ -870,9 +909,10 @@ impl SimServo {
         }
     }
 
-    /// Queues a status packet (if `send`), starting after the return delay.
+    /// Queues a status packet (if `send`), starting after the return delay (and the injected
+    /// [`Faults::reply_delay_us`]); an answer the faults drop is never sent.
     fn reply(&mut self, heard_ns: u64, data: &[u8], send: bool) {
-        if !send {
+        if !send || self.drops_answer() {
             return;
         }
         let err = self.reg(reg::STATUS);
@@ -885,9 +925,28 @@ impl SimServo {
         if corrupt && let Some(chk) = bytes.last_mut() {
             *chk ^= 0x5A;
         }
-        let start = heard_ns + PROCESSING_NS + u64::from(self.reg(reg::RETURN_DELAY)) * 2_000;
+        let start = heard_ns
+            + PROCESSING_NS
+            + u64::from(self.reg(reg::RETURN_DELAY)) * 2_000
+            + u64::from(self.faults.reply_delay_us) * 1_000;
         self.replies.push_back((start, bytes));
         self.stats.replies += 1;
+    }
+
+    /// Whether the answer about to be queued is lost: one of [`SimServo::drop_next_answers`],
+    /// or its share of [`Faults::dropped_per_mille`] (every answer adds its thousandths to a
+    /// debt; each whole answer owed is dropped).
+    fn drops_answer(&mut self) -> bool {
+        if self.answers_to_drop > 0 {
+            self.answers_to_drop -= 1;
+            return true;
+        }
+        self.drop_debt += u32::from(self.faults.dropped_per_mille.min(1000));
+        if self.drop_debt >= 1000 {
+            self.drop_debt -= 1000;
+            return true;
+        }
+        false
     }
 
     fn read_block(&self, addr: u8, count: u8) -> Vec<u8> {
@@ -1511,6 +1570,70 @@ mod tests {
         assert!(
             rig.read(1, reg::PRESENT_POSITION, 2).is_some(),
             "third is healthy"
+        );
+    }
+
+    #[test]
+    fn a_late_servo_answers_late_and_still_occupies_the_wire() {
+        let mut rig = Rig::new(&[1]);
+        let read = Instruction::Read { addr: 56, count: 2 }
+            .to_packet(1)
+            .unwrap();
+        let on_time = rig.exchange(&read);
+        let normal = rig.turnaround_ns(&on_time);
+        rig.servo(0).set_faults(Faults::late_replies(500));
+        let late = rig.exchange(&read);
+        assert_eq!(rig.turnaround_ns(&late), normal + 500_000, "500 us later");
+        assert_eq!(rig.answers(&late).len(), 1, "the whole answer still comes");
+        // A late answer that meets the controller's next instruction garbles both.
+        let now = rig.now_ns;
+        rig.bus.take_trace();
+        rig.bus
+            .port(rig.controller)
+            .unwrap()
+            .write(&read.to_bytes());
+        rig.bus.start_transmissions(now);
+        rig.run_until(now + 560_000);
+        let ping = Instruction::Ping.to_packet(9).unwrap();
+        rig.bus
+            .port(rig.controller)
+            .unwrap()
+            .write(&ping.to_bytes());
+        rig.bus.start_transmissions(rig.now_ns);
+        rig.run_for_ms(2);
+        let trace = rig.bus.take_trace();
+        let answer: Vec<&BusByte> = trace.iter().filter(|b| b.from != rig.controller).collect();
+        assert!(!answer.is_empty(), "the late answer went on the wire");
+        assert!(
+            answer.iter().any(|b| b.garbled),
+            "and collided with the ping: {trace:?}"
+        );
+    }
+
+    #[test]
+    fn dropped_answers_are_lost_evenly_or_the_next_few() {
+        let mut rig = Rig::new(&[1]);
+        rig.servo(0).set_faults(Faults::dropped_replies(250));
+        let answered: Vec<bool> = (0..8)
+            .map(|_| rig.read(1, reg::PRESENT_POSITION, 2).is_some())
+            .collect();
+        assert_eq!(
+            answered,
+            [true, true, true, false, true, true, true, false],
+            "one in four"
+        );
+        rig.servo(0).set_faults(Faults::NONE);
+        rig.servo(0).drop_next_answers(2);
+        assert!(rig.read(1, reg::PRESENT_POSITION, 2).is_none());
+        assert!(rig.read(1, reg::PRESENT_POSITION, 2).is_none());
+        assert!(
+            rig.read(1, reg::PRESENT_POSITION, 2).is_some(),
+            "answers again"
+        );
+        assert_eq!(
+            rig.servo(0).stats().replies,
+            7,
+            "a lost answer is not counted"
         );
     }
 

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::{Parser, ValueEnum};
 
 use crate::sim::contact::Obstacle;
+use crate::sim::reply_faults::ReplyFault;
 use crate::sim::{FlashTiming, HostLink};
 
 /// Virtual myCobot 280 M5: the real Basic and Atom firmware logic, simulated servos, served in
@@ -55,6 +56,15 @@ pub struct Cli {
     /// through what the joint's servo reports, as on the real arm.
     #[arg(long = "obstacle", value_name = "J:DEG", allow_hyphen_values = true)]
     pub obstacles: Vec<Obstacle>,
+    /// Every answer of servo ID (1..7, 7 the gripper) starts US microseconds late (repeatable),
+    /// e.g. `--late-replies 3:300`: past the Atom's deadline from about 200 us on, and still on
+    /// the wire when it comes, as with a slow servo or a slow board.
+    #[arg(long = "late-replies", value_name = "ID:US", value_parser = ReplyFault::late)]
+    pub late_replies: Vec<ReplyFault>,
+    /// Servo ID loses PER_MILLE of every thousand answers, spread evenly (repeatable), e.g.
+    /// `--lost-replies 2:100` (every tenth), `--lost-replies 2:1000` (all).
+    #[arg(long = "lost-replies", value_name = "ID:PER_MILLE", value_parser = ReplyFault::lost)]
+    pub lost_replies: Vec<ReplyFault>,
 
     /// How long a board stands still while its flash erases or writes (loop stopped, UART
     /// receiving into its 128-byte FIFO only): the datasheet's typical times, its worst case,
@@ -153,6 +163,23 @@ mod tests {
         assert_eq!(blocked.obstacles.len(), 2);
         assert_eq!(blocked.obstacles[0].angle.0, -3000);
         assert!(Cli::try_parse_from(["open-mycobot", "--obstacle", "9:10"]).is_err());
+
+        let faulty = [
+            "open-mycobot",
+            "--late-replies",
+            "3:300",
+            "--lost-replies",
+            "2:100",
+            "--lost-replies",
+            "5:1000",
+        ];
+        let faulty = Cli::try_parse_from(faulty).unwrap();
+        assert_eq!(
+            faulty.late_replies[0].trouble,
+            crate::sim::reply_faults::ReplyTrouble::Late(300)
+        );
+        assert_eq!(faulty.lost_replies.len(), 2);
+        assert!(Cli::try_parse_from(["open-mycobot", "--lost-replies", "2:2000"]).is_err());
     }
 
     #[test]

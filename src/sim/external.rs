@@ -27,6 +27,7 @@
 use protocol_core::BytePort;
 
 use super::contact::Obstacle;
+use super::reply_faults::ReplyFault;
 use super::robot::SERVO_IDS;
 use super::servo::SimServo;
 use super::wire::{Bus, HeardByte, StationId};
@@ -197,6 +198,12 @@ impl EmulatedArm {
     /// default configuration does (the emulated Atom runs it); `false` if there is no such servo.
     pub fn add_obstacle(&mut self, obstacle: Obstacle) -> bool {
         obstacle.place(&mut self.servos, &AtomConfig::default())
+    }
+
+    /// Makes a servo's answers late or lost ([`ReplyFault`]); `false` if there is no such
+    /// servo.
+    pub fn add_reply_fault(&mut self, fault: ReplyFault) -> bool {
+        fault.apply(&mut self.servos)
     }
 
     /// Virtual time, in microseconds.

@@ -6,6 +6,8 @@
 //! * [`servo`]: a simulated STS servo: control table, instructions, trapezoidal motion, faults,
 //!   contact (obstacles, pushes, the load they cause).
 //! * [`contact`]: obstacles in a joint's way (`--obstacle J:DEG`).
+//! * [`reply_faults`]: a servo's answers late or lost (`--late-replies ID:US`,
+//!   `--lost-replies ID:PER_MILLE`).
 //! * [`external`]: the same bus and servos serving boards that run elsewhere (the real images on
 //!   an emulated chip), whole frames in and the bus's bytes, echo included, out.
 //! * [`VirtualRobot`]: the real `firmware_basic::Basic` and `firmware_atom::Atom` wired to seven
@@ -19,12 +21,14 @@
 //!   its own answers), or one request at a time with [`VirtualRobot::ask`],
 //!   [`VirtualRobot::transact`] and [`VirtualRobot::await_frame`];
 //! * drive it in real time: call [`VirtualRobot::run_until`] with the wall clock;
-//! * break things: [`SimServo::set_faults`] (no answer, bad checksum, stall, overheat),
-//!   [`SimServo::power_cycle`], [`SimServo::move_by_hand`], [`VirtualRobot::inject_bus_noise`],
+//! * break things: [`SimServo::set_faults`] (no answer, bad checksum, stall, overheat,
+//!   answers late or lost: [`Faults::reply_delay_us`], [`Faults::dropped_per_mille`]),
+//!   [`SimServo::drop_next_answers`], [`SimServo::power_cycle`], [`SimServo::move_by_hand`], [`VirtualRobot::inject_bus_noise`],
 //!   [`VirtualRobot::reset_atom`], [`VirtualRobot::reset_basic`], [`VirtualRobot::add_obstacle`]
 //!   and [`VirtualRobot::push_joint`] (contact, felt by the Atom's collision protection,
 //!   [`VirtualRobot::collisions`]), and [`RobotConfig`] for echo
-//!   wiring, a robot without a Basic, and the firmware configurations;
+//!   wiring, a robot without a Basic, a slow Atom ([`RobotConfig::atom_loop_us`]), and the
+//!   firmware configurations;
 //! * look: [`VirtualRobot::measured_angles`] (where the shafts really are),
 //!   [`VirtualRobot::shaft_angles_deg`] and [`measure`] (the flange's true pose), the servos' tables
 //!   and [`ServoStats`], and every byte on the bus with its sender and times
@@ -44,6 +48,7 @@ pub mod contact;
 pub mod external;
 pub mod flash_timing;
 pub mod measure;
+pub mod reply_faults;
 mod robot;
 
 pub use sim_hw::{servo, wire};

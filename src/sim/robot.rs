@@ -14,6 +14,7 @@ use protocol_core::{Frame, FrameDecoder};
 use super::basic_flash::BasicFlashStore;
 use super::contact::{self, Obstacle};
 use super::flash_timing::{FlashTiming, FlashWork};
+use super::reply_faults::ReplyFault;
 use super::servo::SimServo;
 use super::wire::{Bus, HeardByte, SerialLine, SerialPort, StationId};
 use sim_hw::ServoChain;
@@ -771,6 +772,12 @@ impl VirtualRobot {
     /// Puts `obstacle` in its joint's way ([`Obstacle`]); `false` if that joint has no servo.
     pub fn add_obstacle(&mut self, obstacle: Obstacle) -> bool {
         obstacle.place(&mut self.servos, self.atom.config())
+    }
+
+    /// Makes a servo's answers late or lost ([`ReplyFault`]); `false` if there is no such
+    /// servo.
+    pub fn add_reply_fault(&mut self, fault: ReplyFault) -> bool {
+        fault.apply(&mut self.servos)
     }
 
     /// Pushes joint `joint` (1..=6) with an external torque of `permille` thousandths of its

@@ -78,8 +78,9 @@ impl Follower {
         let full = i64::from(config.motion.servo_accel_steps_per_s2.max(100));
         let period = period_us.max(1) as i64;
         let cap = i64::from(speed_cap_steps_per_s.max(1));
-        let answering: [bool; JOINTS] =
-            core::array::from_fn(|j| bank.health(j).is_some_and(|h| h.answering));
+        // Every joint that holds torque follows, whether or not its latest reads came back: it
+        // still hears the goals, and one left without them would run on to its last goal.
+        let driven: [bool; JOINTS] = core::array::from_fn(|j| bank.holds_torque(j));
         let to: [i64; JOINTS] = core::array::from_fn(|j| {
             let angle = target.get(j).copied().unwrap_or_default();
             let exact = config.angle_to_millisteps(j, i32::from(angle.0));
@@ -90,19 +91,31 @@ impl Follower {
                 exact
             }
         });
+        // Where each joint is now: where it should be by the previous target, corrected by a
+        // recent reading ([`ServoBank::observed`](crate::bank::ServoBank::observed)); the first
+        // and the last target start from the reading itself. A joint without a recent reading
+        // goes by what it was told: its reads being late must not make its goal.
         let from: [i64; JOINTS] = core::array::from_fn(|j| {
-            let measured = bank.estimated_millisteps(cx.now_us, j);
+            let measured = bank.observed(cx.now_us, j).map(|m| m.millisteps);
+            let told = || bank.motion(cx.now_us, j).map_or(0, |m| m.millisteps);
             match &self.last {
                 Some((expected, _)) if !last => {
-                    let e = expected.get(j).copied().unwrap_or(measured);
-                    e + (measured - e) * CORRECTION.0 / CORRECTION.1
+                    let e = expected.get(j).copied().unwrap_or_else(told);
+                    measured.map_or(e, |m| e + (m - e) * CORRECTION.0 / CORRECTION.1)
                 }
-                _ => measured,
+                Some((expected, _)) => measured
+                    .or_else(|| expected.get(j).copied())
+                    .unwrap_or_else(told),
+                None => measured.unwrap_or_else(told),
             }
         });
         let before: [i64; JOINTS] = match &self.last {
             Some((_, speeds)) => *speeds,
-            None => core::array::from_fn(|j| i64::from(bank.velocity(j))),
+            None => core::array::from_fn(|j| {
+                bank.observed(cx.now_us, j)
+                    .or_else(|| bank.motion(cx.now_us, j))
+                    .map_or(0, |m| m.millisteps_per_s / 1000)
+            }),
         };
         // Thousandths of a step per microsecond = steps per millisecond: times 1000 is steps/s.
         let speeds: [i64; JOINTS] = core::array::from_fn(|j| {
@@ -124,7 +137,7 @@ impl Follower {
         // The time every joint takes to change its speed: the largest change at full
         // acceleration (at least a millisecond, the servos' control period).
         let largest = (0..JOINTS)
-            .filter(|&j| answering.get(j).copied().unwrap_or(false))
+            .filter(|&j| driven.get(j).copied().unwrap_or(false))
             .map(change)
             .max()
             .unwrap_or(0);
@@ -132,7 +145,7 @@ impl Follower {
         let mut goals = Goals::NONE;
         let mut expected = to;
         for j in 0..JOINTS {
-            if !answering.get(j).copied().unwrap_or(false) {
+            if !driven.get(j).copied().unwrap_or(false) {
                 continue;
             }
             let speed = speeds.get(j).copied().unwrap_or(0);
@@ -188,7 +201,7 @@ fn goal_position(settings: &Settings, j: usize, millisteps: i64) -> Steps {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bank::test_support::at_rest;
+    use crate::bank::test_support::{at_rest, bank_read, miss, powered};
 
     const PERIOD_US: u64 = 20_000;
 
@@ -261,5 +274,34 @@ mod tests {
             "the last target is the goal itself"
         );
         assert!(last.speed_steps_per_s >= 50);
+    }
+
+    #[test]
+    fn a_joint_whose_reads_are_lost_still_follows_from_where_it_should_be() {
+        let settings = powered();
+        let mut bank = bank_read(&settings, 0, [2_048; JOINTS], [0; JOINTS]);
+        let mut follower = Follower::default();
+        let mut target = [Centideg(0); JOINTS];
+        target[2] = settings.angle(2, Steps(2_068));
+        let first = {
+            let cx = Context::new(0, &mut bank, &settings);
+            follower.goals_towards(&cx, &leg(target, false))
+        };
+        // Joint 3's next reads are lost (three in a row: it counts as not answering), and the
+        // others' reads are too old to say where anything is now.
+        miss(&mut bank, &settings, 10_000, 2, 3);
+        target[2] = settings.angle(2, Steps(2_088));
+        let cx = Context::new(PERIOD_US + 30_000, &mut bank, &settings);
+        let goals = follower.goals_towards(&cx, &leg(target, false));
+        let (g1, g2) = (first.get(2).unwrap(), goals.get(2).unwrap());
+        // It still gets its goal (without one it would run on to the last, a braking distance
+        // beyond the last target), at the speed of the path from where it should be: 20 steps
+        // a period, as before, not the catching up an old reading would ask for.
+        let diff = i32::from(g2.speed_steps_per_s) - i32::from(g1.speed_steps_per_s);
+        assert!(diff.abs() < 50, "{g1:?} then {g2:?}");
+        assert!(g2.position.0 > 2_088, "{g2:?}");
+        // The last target is its goal, whatever its reads.
+        let last = follower.goals_towards(&cx, &leg(target, true));
+        assert_eq!(last.get(2).unwrap().position, Steps(2_088));
     }
 }

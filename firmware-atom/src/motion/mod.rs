@@ -269,13 +269,19 @@ impl MotionController {
     /// Whether a new motion may start, checked before it is planned so that a refused command
     /// changes nothing: every new motion of the joints passes here (moves, paths, jogs,
     /// streams, resume, drags and goal-register writes). Refused while the arm is powered off,
-    /// or after a collision until [`MotionController::unlock`]. (Every goal, braking included,
-    /// then passes [`crate::safety::check`], which refuses any goal while powered off.)
+    /// after a collision until [`MotionController::unlock`], and while a joint has no fresh
+    /// reading ([`ServoBank::fresh`]: a motion planned from where the arm is must know where
+    /// that is). (Every goal, braking included, then passes [`crate::safety::check`], which
+    /// refuses any goal while powered off.)
     pub fn may_move(&self, cx: &Context<'_>) -> Result<(), AtomError> {
         if !cx.bank.powered() {
             return Err(AtomError::PoweredOff);
         }
-        self.lock.map_or(Ok(()), Err)
+        self.lock.map_or(Ok(()), Err)?;
+        match cx.bank.unknown_joint(cx.now_us) {
+            Some(j) => Err(AtomError::StateLost(j)),
+            None => Ok(()),
+        }
     }
 
     /// Accepts a new motion: refused unless [`MotionController::may_move`], then each kind of
@@ -646,6 +652,7 @@ impl MotionController {
     /// of a stream or a stop, arrival, and the next queued move. An error (a path that cannot
     /// go on, a queued move that became impossible) has stopped the arm and is to be recorded.
     pub fn update(&mut self, cx: &mut Context<'_>) -> Result<(), AtomError> {
+        self.watch_readings(cx)?;
         let watchdog_us = cx.settings.config().timing.jog_watchdog_us;
         if self.jogging() && cx.now_us.saturating_sub(self.last_host_cmd_us) >= watchdog_us {
             self.stop(cx);
@@ -664,6 +671,26 @@ impl MotionController {
             return self.start(cx, Order::Move(next));
         }
         Ok(())
+    }
+
+    /// Stops the motion (and forgets what waits) when a joint's readings stopped or jumped
+    /// ([`ServoBank::unknown_joint`], [`ServoBank::take_jump`]): the arm does not go on from
+    /// where it can only guess the joint is. The brake goes by what each joint was told
+    /// ([`brake`]); a stop already under way goes on. The error is for 0x07.
+    fn watch_readings(&mut self, cx: &mut Context<'_>) -> Result<(), AtomError> {
+        let jumped = cx.bank.take_jump();
+        let Some(j) = jumped.or_else(|| cx.bank.unknown_joint(cx.now_us)) else {
+            return Ok(());
+        };
+        match self.activity {
+            Activity::Idle if self.queue.is_empty() => Ok(()),
+            Activity::Braking { then: None, .. } => Err(AtomError::StateLost(j)),
+            _ => {
+                self.forget_plans();
+                self.brake(cx, None);
+                Err(AtomError::StateLost(j))
+            }
+        }
     }
 
     fn advance(&mut self, cx: &mut Context<'_>) -> Result<(), AtomError> {
@@ -1007,27 +1034,26 @@ fn jog_end(cx: &Context<'_>, j: usize, direction: JogDirection) -> Result<Centid
     }
 }
 
-/// True if the joints that answer are within [`tolerance::IN_POSITION_CENTIDEG`] of `target`
-/// and none of them reports moving (a servo that does not answer cannot arrive: it is judged by
-/// the rest).
+/// True if every joint is within [`tolerance::IN_POSITION_CENTIDEG`] of `target` and its
+/// latest fresh reading says it is at rest on its goal ([`Context::joints_moving`]): a joint
+/// whose reads do not come back cannot arrive.
 fn arrived(cx: &Context<'_>, target: &[Centideg; JOINTS]) -> bool {
-    let present = cx.present_angles();
-    let seen: [Centideg; JOINTS] = core::array::from_fn(|j| {
-        if cx.bank.health(j).is_some_and(|h| h.answering) {
-            present.get(j).copied().unwrap_or_default()
-        } else {
-            target.get(j).copied().unwrap_or_default()
-        }
-    });
-    tolerance::angles_match(&seen, target) && !cx.joints_moving()
+    tolerance::angles_match(&cx.present_angles(), target) && !cx.joints_moving()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bank::test_support::at_rest;
+    use crate::bank::test_support::{at_rest, read, reread, state};
     use crate::config::AtomConfig;
     use crate::settings::Settings;
+
+    /// Moves the step's time on to `now_us`, the servos read again meanwhile (at rest where
+    /// they were: they never move here).
+    fn later(cx: &mut Context<'_>, now_us: u64) {
+        cx.now_us = now_us;
+        reread(cx.bank, cx.settings, now_us);
+    }
 
     #[test]
     fn every_new_motion_is_refused_while_powered_off() {
@@ -1083,7 +1109,7 @@ mod tests {
             "the second waits"
         );
         // The servos never report arriving here: the first move ends after its overtime.
-        cx.now_us = 10 * MOVE_OVERTIME_US;
+        later(cx, 10 * MOVE_OVERTIME_US);
         assert_eq!(motion.update(cx), Ok(()));
         assert_eq!(motion.planned_angles(cx)[1], Centideg(500), "its turn");
         let held = settings.angle(0, settings.goal_steps(0, Centideg(1_000)));
@@ -1098,11 +1124,11 @@ mod tests {
         let first = Target::joint(0, Centideg(1_000), 100);
         let second = Target::joint(1, Centideg(500), 100);
         assert_eq!(motion.command(cx, Command::Move(first)), Ok(()));
-        cx.now_us = 200_000;
+        later(cx, 200_000);
         assert_eq!(motion.command(cx, Command::Move(second)), Ok(()));
         assert!(matches!(motion.activity, Activity::Braking { .. }));
         assert_eq!(motion.planned_angles(cx)[1], Centideg(500));
-        cx.now_us = 400_000;
+        later(cx, 400_000);
         assert_eq!(motion.update(cx), Ok(()));
         assert!(matches!(motion.activity, Activity::Joint { .. }), "started");
     }
@@ -1122,7 +1148,7 @@ mod tests {
             motion.activity,
             Activity::Braking { then: None, .. }
         ));
-        cx.now_us = 10 * MOVE_OVERTIME_US;
+        later(cx, 10 * MOVE_OVERTIME_US);
         assert_eq!(motion.update(cx), Ok(()));
         assert!(!motion.is_active(), "nothing queued starts");
     }
@@ -1141,14 +1167,75 @@ mod tests {
         assert_eq!(motion.command(cx, jog), Ok(()));
         assert!(motion.jogging());
         let watchdog_us = settings.config().timing.jog_watchdog_us;
-        cx.now_us = watchdog_us - 1;
+        later(cx, watchdog_us - 1);
         assert_eq!(motion.update(cx), Ok(()));
         assert!(motion.jogging());
-        cx.now_us = watchdog_us;
+        later(cx, watchdog_us);
         assert_eq!(motion.update(cx), Ok(()));
         assert!(
             matches!(motion.activity, Activity::Braking { .. }),
             "stopped"
         );
+    }
+
+    #[test]
+    fn a_motion_stops_with_the_joints_error_when_its_readings_stop() {
+        let (settings, mut bank) = at_rest();
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        let target = Target::joint(0, Centideg(3_000), 50);
+        assert_eq!(motion.command(cx, Command::Move(target)), Ok(()));
+        later(cx, 40_000);
+        assert_eq!(motion.update(cx), Ok(()));
+        // Joint 5 is read no more: 50 ms on, nobody knows where it is.
+        cx.now_us = 40_000 + crate::bank::FRESH_STATE_US + 1;
+        for i in (0..crate::config::SERVOS).filter(|&i| i != 4) {
+            let id = settings.config().servo_ids[i];
+            read(
+                cx.bank,
+                cx.settings,
+                cx.now_us,
+                i,
+                state(id, 2_048, 0, 2_048),
+            );
+        }
+        assert_eq!(motion.update(cx), Err(AtomError::StateLost(4)));
+        assert!(
+            matches!(motion.activity, Activity::Braking { then: None, .. }),
+            "stopped"
+        );
+        // Nothing new starts meanwhile, and the error stays while it lasts.
+        let again = Target::joint(1, Centideg(1_000), 50);
+        assert_eq!(
+            motion.command(cx, Command::Move(again)),
+            Err(AtomError::StateLost(4))
+        );
+        assert_eq!(motion.update(cx), Err(AtomError::StateLost(4)));
+        // Read again: the stop ends, and motion may start.
+        later(cx, cx.now_us + 300_000);
+        assert_eq!(motion.update(cx), Ok(()));
+        assert!(!motion.is_active());
+        assert_eq!(motion.command(cx, Command::Move(again)), Ok(()));
+    }
+
+    #[test]
+    fn a_reading_that_jumps_stops_the_motion_and_one_at_rest_is_no_error() {
+        let (settings, mut bank) = at_rest();
+        let mut motion = MotionController::new();
+        let cx = &mut Context::new(0, &mut bank, &settings);
+        // Holding still, no fresh reading is no error: there is nothing to stop.
+        later(cx, 0);
+        cx.now_us = 200_000;
+        assert_eq!(motion.update(cx), Ok(()));
+        later(cx, 200_000);
+        let target = Target::joint(0, Centideg(3_000), 50);
+        assert_eq!(motion.command(cx, Command::Move(target)), Ok(()));
+        later(cx, 204_000);
+        assert_eq!(motion.update(cx), Ok(()));
+        // Joint 2 reads 0 (a reply that says nothing) 4 ms after 2048: not a place it can be.
+        read(cx.bank, cx.settings, 208_000, 1, state(2, 0, 0, 2_048));
+        cx.now_us = 208_000;
+        assert_eq!(motion.update(cx), Err(AtomError::StateLost(1)));
+        assert!(matches!(motion.activity, Activity::Braking { .. }));
     }
 }

@@ -86,6 +86,9 @@ pub enum ErrorCode {
     JointLimit(JointId),
     /// A collision was detected (16..=19; the value is 0..=3, code minus 16).
     Collision(u8),
+    /// A joint's state readings stopped or jumped (its servo's replies late, lost or
+    /// inconsistent), so the motion stopped: 21..=26, 20 + the joint number.
+    StateLost(JointId),
     /// The pose has no inverse-kinematics solution (32).
     IkNoSolution,
     /// A linear move found no adjacent solution along the line (33 or 34; the value is 0 or
@@ -100,6 +103,7 @@ impl ErrorCode {
             Self::None => 0,
             Self::JointLimit(j) => j.get(),
             Self::Collision(n) => 16 + (n & 3),
+            Self::StateLost(j) => 20 + j.get(),
             Self::IkNoSolution => 32,
             Self::LinearNoAdjacentSolution(n) => 33 + (n & 1),
         }
@@ -114,6 +118,10 @@ impl ErrorCode {
                 None => None,
             },
             16..=19 => Some(Self::Collision(code - 16)),
+            21..=26 => match JointId::new(code - 20) {
+                Some(j) => Some(Self::StateLost(j)),
+                None => None,
+            },
             32 => Some(Self::IkNoSolution),
             33 | 34 => Some(Self::LinearNoAdjacentSolution(code - 33)),
             _ => None,
@@ -190,6 +198,13 @@ mod tests {
         assert_eq!(ErrorCode::IkNoSolution.code(), 32);
         assert_eq!(ErrorCode::JointLimit(JointId::new(6).unwrap()).code(), 6);
         assert_eq!(ErrorCode::from_code(7), None);
+        assert_eq!(ErrorCode::from_code(20), None);
+        assert_eq!(ErrorCode::from_code(27), None);
+        assert_eq!(
+            ErrorCode::StateLost(JointId::new(3).unwrap()).code(),
+            23,
+            "joint 3's readings stopped"
+        );
         assert_eq!(
             ErrorCode::from_code(34),
             Some(ErrorCode::LinearNoAdjacentSolution(1))
