@@ -50,6 +50,12 @@ impl<'d> LoopWatchdog<'d> {
         crate::board_log!("reset reason: {:?}", esp_hal::system::reset_reason());
         // Stage 0 resets the system, the other stages are off (esp-hal's `enable`).
         let mut main = TimerGroup::new(timg1).wdt;
+        // First a timeout long enough to need a clock prescaler of 2, then the real one (1):
+        // the prescaler changes twice, which silicon does not care about, but the ESP32-C3
+        // model of the QEMU fork docs/boards.md names computes the watchdog's clock only when
+        // the prescaler changes, and divides by zero (SIGFPE, the emulator dies) at `enable`
+        // after a first timeout with the reset value 1.
+        main.set_timeout(MwdtStage::Stage0, Duration::from_secs(120));
         main.set_timeout(MwdtStage::Stage0, Duration::from_millis(TIMEOUT_MS));
         main.enable();
         let mut rtc = Rtc::new(rtc_timer);
