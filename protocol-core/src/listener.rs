@@ -489,7 +489,9 @@ impl Listener {
                     break;
                 }
             }
-            // A frame candidate starting inside the packet is dropped up to the packet's end.
+            on_heard(Heard::Packet(packet));
+            // A frame candidate starting inside the packet is dropped up to the packet's end;
+            // what follows the packet is scanned again.
             let frame_front = self.frames_front();
             if self.config.frames && frame_front >= start && frame_front < end {
                 // end - frame_front <= a packet's length.
@@ -497,7 +499,6 @@ impl Listener {
                 let next = self.frames.next_frame();
                 self.found_frames(next, on_heard);
             }
-            on_heard(Heard::Packet(packet));
             next = self.packets.next_packet();
         }
     }
