@@ -11,6 +11,8 @@ use protocol_core::units::Centideg;
 
 use sim_hw::{ServoChain, SimServo};
 
+use super::arg_error::ArgError;
+
 /// A rigid stop for joint `joint` (1..=6) at `angle`: the joint cannot move past it from the
 /// side it is on when the stop is placed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -63,24 +65,12 @@ fn joint_servo<'a>(
     servos.get_mut(id)
 }
 
-/// Why an `--obstacle` value was refused.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ObstacleParseError(String);
-
-impl fmt::Display for ObstacleParseError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for ObstacleParseError {}
-
 impl FromStr for Obstacle {
-    type Err = ObstacleParseError;
+    type Err = ArgError;
 
     /// `J:DEG`, e.g. `2:-30` or `1:45.5`: joint 1..=6, angle in degrees within -180..=180.
     fn from_str(text: &str) -> Result<Self, Self::Err> {
-        let refuse = |why: &str| ObstacleParseError(format!("{text:?}: {why} (expected J:DEG)"));
+        let refuse = |why: &str| ArgError::new(text, why, "J:DEG");
         let (joint, degrees) = text.split_once(':').ok_or_else(|| refuse("no colon"))?;
         let joint: u8 = joint
             .trim()

@@ -43,6 +43,7 @@
 //! assert_eq!(robot.servo(1).map(|s| s.present_position()), Some(2048));
 //! ```
 
+pub mod arg_error;
 mod basic_flash;
 pub mod contact;
 pub mod external;

@@ -8,6 +8,8 @@ use std::fmt;
 
 use sim_hw::ServoChain;
 
+use super::arg_error::ArgError;
+
 /// Longest `--late-replies` delay, microseconds: 100 ms, far past any deadline.
 pub const MAX_REPLY_DELAY_US: u32 = 100_000;
 
@@ -31,12 +33,12 @@ pub struct ReplyFault {
 
 impl ReplyFault {
     /// `ID:US` (`--late-replies`): servo 1..=7, a delay of 0..=[`MAX_REPLY_DELAY_US`].
-    pub fn late(text: &str) -> Result<Self, ReplyFaultParseError> {
+    pub fn late(text: &str) -> Result<Self, ArgError> {
         let (servo, value) = split(text, "ID:US")?;
         let delay = u32::try_from(value)
             .ok()
             .filter(|&us| us <= MAX_REPLY_DELAY_US)
-            .ok_or_else(|| refuse(text, "the delay is 0..100000 us", "ID:US"))?;
+            .ok_or_else(|| ArgError::new(text, "the delay is 0..100000 us", "ID:US"))?;
         Ok(Self {
             servo,
             trouble: ReplyTrouble::Late(delay),
@@ -44,12 +46,12 @@ impl ReplyFault {
     }
 
     /// `ID:PER_MILLE` (`--lost-replies`): servo 1..=7, 0..=1000 of every thousand answers.
-    pub fn lost(text: &str) -> Result<Self, ReplyFaultParseError> {
+    pub fn lost(text: &str) -> Result<Self, ArgError> {
         let (servo, value) = split(text, "ID:PER_MILLE")?;
         let per_mille = u16::try_from(value)
             .ok()
             .filter(|&p| p <= 1000)
-            .ok_or_else(|| refuse(text, "0..1000 of every thousand", "ID:PER_MILLE"))?;
+            .ok_or_else(|| ArgError::new(text, "0..1000 of every thousand", "ID:PER_MILLE"))?;
         Ok(Self {
             servo,
             trouble: ReplyTrouble::Lost(per_mille),
@@ -85,37 +87,21 @@ impl fmt::Display for ReplyFault {
     }
 }
 
-/// Why a `--late-replies` or `--lost-replies` value was refused.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ReplyFaultParseError(String);
-
-impl fmt::Display for ReplyFaultParseError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for ReplyFaultParseError {}
-
-fn refuse(text: &str, why: &str, form: &str) -> ReplyFaultParseError {
-    ReplyFaultParseError(format!("{text:?}: {why} (expected {form})"))
-}
-
 /// The servo id (1..=7) and the number of `text`, `ID:N`.
-fn split(text: &str, form: &str) -> Result<(u8, u64), ReplyFaultParseError> {
+fn split(text: &str, form: &str) -> Result<(u8, u64), ArgError> {
     let (servo, value) = text
         .split_once(':')
-        .ok_or_else(|| refuse(text, "no colon", form))?;
+        .ok_or_else(|| ArgError::new(text, "no colon", form))?;
     let servo: u8 = servo
         .trim()
         .parse()
         .ok()
         .filter(|id| (1..=7).contains(id))
-        .ok_or_else(|| refuse(text, "the servo is 1..7", form))?;
+        .ok_or_else(|| ArgError::new(text, "the servo is 1..7", form))?;
     let value: u64 = value
         .trim()
         .parse()
-        .map_err(|_| refuse(text, "not a whole number", form))?;
+        .map_err(|_| ArgError::new(text, "not a whole number", form))?;
     Ok((servo, value))
 }
 
