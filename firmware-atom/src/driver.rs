@@ -154,14 +154,17 @@ impl ServoDriver {
         let bytes = packet.to_bytes();
         bus.write(&bytes);
         rx.on_transmit(now_us, &bytes);
-        let tx_us = wire_time_us(bytes.len() as u32, BUS_BAUD);
+        // The instruction may follow other bytes still going out (a host reply).
+        let sent_us = rx
+            .busy_until_us()
+            .max(now_us + wire_time_us(bytes.len() as u32, BUS_BAUD));
         let answer_us = op
             .answer_data_len()
             .map(|n| SERVO_TURNAROUND_MAX_US + wire_time_us(u32::from(n) + 6, BUS_BAUD))
             .unwrap_or(0);
         self.in_flight = Some(InFlight {
             op,
-            deadline_us: now_us + tx_us + answer_us + self.reply_margin_us,
+            deadline_us: sent_us + answer_us + self.reply_margin_us,
         });
         true
     }

@@ -3,7 +3,8 @@
 //! One servo transaction at a time ([`ServoDriver`]). Between transactions the wire stays
 //! silent for [`ATOM_TRANSACTION_GAP_US`] so the Basic can send a host frame; a frame that
 //! starts holds the schedule until it ends, and its reply goes out at once (from cached
-//! state), before the next transaction. Transactions, by priority: servo operations of host
+//! state), followed on the wire by the next transaction with no gap (so a host that sends
+//! request after request cannot take every gap). Transactions, by priority: servo operations of host
 //! commands (torque, calibration, register access), then the newest goals, then the state
 //! refresh, which reads every servo in turn. After every non-refresh transaction one refresh
 //! read runs, so host traffic cannot starve the state refresh.
@@ -155,6 +156,15 @@ impl BusSchedule {
         self.driver.poll(now_us, bus)
     }
 
+    /// True if nothing is under way on the bus: no servo transaction in flight, no reply
+    /// waiting to go out or to be sent again, no frame or packet half heard.
+    pub fn is_idle(&self) -> bool {
+        !self.driver.busy()
+            && self.reply.is_none()
+            && self.resend.is_none()
+            && !self.rx.frame_in_progress()
+    }
+
     /// True if the receiver saw a corrupt servo packet since the transaction in flight started.
     pub fn saw_corruption(&self) -> bool {
         self.rx.checksum_errors() != self.checksum_errors_at_start
@@ -185,6 +195,7 @@ impl BusSchedule {
             None if resend_due => self.resend.take(),
             None => None,
         };
+        let replied = reply.is_some();
         if let Some(reply) = reply {
             let bytes = reply.to_bytes();
             bus.write(&bytes);
@@ -192,18 +203,18 @@ impl BusSchedule {
             let window_us = wire_time_us(bytes.len() as u32, BUS_BAUD) + OWN_REPLY_WINDOW_US;
             self.last_reply = Some((reply, now_us + window_us));
             self.reply_on_wire = true;
-            return;
-        }
-        if self.resend.is_some() {
+        } else if self.resend.is_some() {
             // Hold the servo schedule until the resent reply is out.
             return;
-        }
-        if self.rx.frame_in_progress()
+        } else if self.rx.frame_in_progress()
             || !bus.tx_idle()
             || self.rx.quiet_us(now_us) < ATOM_TRANSACTION_GAP_US
         {
             return;
         }
+        // A reply is followed at once by the next transaction, with no gap: the Basic waits
+        // for a quiet wire before its next request, so a host that keeps the bus busy still
+        // leaves every other turn to the servos, and the state refresh cannot starve.
         let op = if self.owe_refresh {
             self.owe_refresh = false;
             bank.next_refresh_op(settings)
@@ -219,7 +230,8 @@ impl BusSchedule {
         if let Some(op) = op
             && self.driver.start(now_us, op, bus, &mut self.rx)
         {
-            self.reply_on_wire = false;
+            // Right behind a reply, a collision the echo reports may concern either.
+            self.reply_on_wire = replied;
             self.checksum_errors_at_start = self.rx.checksum_errors();
         }
     }
@@ -300,13 +312,20 @@ mod tests {
     }
 
     #[test]
-    fn a_reply_goes_out_before_the_next_transaction() {
+    fn a_reply_goes_out_first_and_the_next_transaction_right_behind_it() {
         let (settings, mut bank) = at_rest();
         let mut schedule = BusSchedule::new(settings.config().timing.reply_margin_us);
         let mut wire = Wire::default();
         let reply = Frame::new(0x20, &[1]).unwrap();
         schedule.send_reply(reply.clone());
         schedule.start_next(10_000, &mut wire, &mut bank, &settings);
-        assert_eq!(wire.written, [reply.to_bytes().to_vec()]);
+        assert_eq!(wire.written.len(), 2, "{:?}", wire.written);
+        assert_eq!(wire.written[0], reply.to_bytes().to_vec());
+        assert_eq!(
+            wire.written[1][..2],
+            [0xFF, 0xFF],
+            "a servo instruction, no gap"
+        );
+        assert!(schedule.driver.busy());
     }
 }

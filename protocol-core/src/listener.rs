@@ -366,6 +366,12 @@ impl Listener {
         now_us.saturating_sub(self.last_activity_us)
     }
 
+    /// When the line was last busy, in us: the end of the last byte heard, or of what the
+    /// station wrote (later than now while its bytes are still going out).
+    pub fn busy_until_us(&self) -> u64 {
+        self.last_activity_us
+    }
+
     /// Received bytes recognised as the station's own echo and dropped. Wraps.
     pub fn echo_bytes(&self) -> u32 {
         self.echo_bytes
