@@ -150,6 +150,8 @@ fn settings_are_taken_in_range_refused_outside_and_survive_a_restart() {
     assert_eq!(answer(&mut robot, 0x75, &[3, 250]), [1]);
     assert_eq!(answer(&mut robot, 0x75, &[6, 50]), [1]);
     assert_eq!(answer(&mut robot, 0x74, &[0]), [1]);
+    // Written to flash once the arm has been quiet for 20 ms (docs/protocol.md).
+    robot.run_for(50_000);
     robot.reset_atom();
     robot.run_for(1_000_000);
     assert_eq!(answer(&mut robot, 0xFD, &[]), [0]);

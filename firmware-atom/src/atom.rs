@@ -22,11 +22,13 @@ use crate::collision::{Collision, CollisionSettings};
 use crate::config::{AtomConfig, ConfigError, JOINTS, JointLimit};
 use crate::context::Context;
 use crate::driver::{Op, Outcome};
+use crate::flash_writes::QUIET_US;
 use crate::io::AtomIo;
 use crate::link::{Link, READ_BUDGET, UsbLink};
 use crate::parts::Parts;
 use crate::schedule::{BusEvent, BusSchedule};
 use crate::settings::Settings;
+use crate::store::ParamStore;
 
 /// The Atom firmware. Create it once with [`Atom::new`] and call [`Atom::poll`] in a loop.
 pub struct Atom {
@@ -39,6 +41,9 @@ pub struct Atom {
     config_error: Option<ConfigError>,
     /// The settings kept in flash were loaded (at the first poll, where the store is lent).
     stored_settings_loaded: bool,
+    /// When the last request (bus or USB) was heard: records wait for flash until the arm has
+    /// been quiet for [`QUIET_US`].
+    last_request_us: u64,
 }
 
 impl Atom {
@@ -57,6 +62,7 @@ impl Atom {
             button_was_pressed: false,
             config_error,
             stored_settings_loaded: false,
+            last_request_us: 0,
         }
     }
 
@@ -100,6 +106,23 @@ impl Atom {
         self.update_button(io);
         self.schedule
             .start_next(now_us, bus, &mut self.parts.bank, &self.parts.settings);
+        self.write_flash_when_quiet(now_us, io);
+    }
+
+    /// Writes one record waiting for the flash ([`crate::flash_writes`]) if the arm is quiet:
+    /// no request heard for [`QUIET_US`], nothing moving or being recorded, no servo
+    /// transaction, reply or read under way. The flash stops the chip meanwhile.
+    fn write_flash_when_quiet<I: AtomIo>(&mut self, now_us: u64, io: &mut I) {
+        let p = &self.parts;
+        let quiet = !p.flash_writes.is_empty()
+            && now_us.saturating_sub(self.last_request_us) >= QUIET_US
+            && !p.is_moving(now_us)
+            && !p.drag.is_recording()
+            && p.waiting.is_empty()
+            && self.schedule.is_idle();
+        if let (true, Some(flash)) = (quiet, io.param_store()) {
+            self.parts.flash_writes.write_one(flash);
+        }
     }
 
     fn on_bus_event<U: BytePort, I: AtomIo>(
@@ -111,6 +134,7 @@ impl Atom {
     ) {
         match event {
             BusEvent::Frame(frame) => {
+                self.last_request_us = now_us;
                 if let Some(reply) =
                     crate::commands::handle(&mut self.parts, now_us, &frame, Link::Bus, io)
                 {
@@ -127,7 +151,9 @@ impl Atom {
 
     fn receive_usb<U: BytePort, I: AtomIo>(&mut self, now_us: u64, usb: &mut U, io: &mut I) {
         let parts = &mut self.parts;
+        let last_request_us = &mut self.last_request_us;
         let mut answer = |frame: Frame, usb: &mut U| {
+            *last_request_us = now_us;
             if let Some(reply) = crate::commands::handle(parts, now_us, &frame, Link::Usb, io) {
                 usb.write(&reply.to_bytes());
             }
@@ -167,9 +193,9 @@ impl Atom {
             return;
         };
         let cx = &mut Context::new(now_us, &mut p.bank, &p.settings);
-        let reply = p
-            .waiting
-            .complete(cx, &mut p.motion, io.param_store(), done);
+        let mut flash = p.flash_writes.over(io.param_store());
+        let store = flash.as_mut().map(|f| f as &mut dyn ParamStore);
+        let reply = p.waiting.complete(cx, &mut p.motion, store, done);
         match reply {
             Some((Link::Bus, reply)) => self.schedule.send_reply(reply),
             Some((Link::Usb, reply)) => usb.write(&reply.to_bytes()),

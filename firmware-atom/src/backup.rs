@@ -4,8 +4,10 @@
 //! `BLOCK_ADDR + BLOCK_LEN` (9..=39: angle limits, temperature, voltage and torque limits,
 //! PID, start-up force, dead zones, protection settings, homing offset, operating mode, speed
 //! loop gains: what a replaced or corrupted servo needs), and stores it under the servo's id in
-//! the Atom's flash ([`ParamStore`], `flash_store` on the board and in the virtual robot). It survives a power cycle. The reply waits for every block to be read and stored
-//! ([`crate::waiting`]): `01`, or `00` if a servo did not answer or the flash failed.
+//! the Atom's flash ([`ParamStore`], `flash_store` on the board and in the virtual robot),
+//! through [`crate::flash_writes`]: in force at once, written once the arm is quiet, and then
+//! it survives a power cycle. The reply waits for every block to be read
+//! ([`crate::waiting`]): `01`, or `00` if a servo did not answer.
 //!
 //! A restore writes a stored block back (EEPROM unlocked and locked around it), after the same
 //! checks as any raw write: never the id, baud rate, return delay or status return level (they

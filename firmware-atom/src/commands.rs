@@ -19,11 +19,13 @@ use crate::cartesian::for_client;
 use crate::config::{GRIPPER, JOINTS, SERVOS, in_encoder_range};
 use crate::context::Context;
 use crate::error::AtomError;
+use crate::flash_writes::Queued;
 use crate::health::ServoHealth;
 use crate::io::{AtomIo, PinMode, is_output_pin, mode_allowed};
 use crate::link::Link;
 use crate::motion::{Command, JogDirection, Target};
 use crate::parts::Parts;
+use crate::store::ParamStore;
 use crate::waiting::WaitingRead;
 use crate::{backup, gains, gripper, registers};
 
@@ -83,6 +85,11 @@ fn done() -> Answer {
     Answer::Done(Ok(()))
 }
 
+/// The flash seen through the records waiting for it, as the parts take a store.
+fn as_store<'a>(queued: &'a mut Queued<'_>) -> &'a mut dyn ParamStore {
+    queued
+}
+
 fn execute<I: AtomIo>(
     p: &mut Parts,
     now_us: u64,
@@ -105,6 +112,7 @@ fn execute<I: AtomIo>(
         errors,
         waiting,
         collision: _,
+        flash_writes,
     } = p;
     match request {
         // --- status and system ---
@@ -474,9 +482,10 @@ fn execute<I: AtomIo>(
         R::SetCollisionMode { on } => {
             let mut changed = *settings.collision();
             changed.set_enabled(on);
-            let kept = settings
-                .collision_mut()
-                .replace_kept(changed, io.param_store());
+            let kept = settings.collision_mut().replace_kept(
+                changed,
+                flash_writes.over(io.param_store()).as_mut().map(as_store),
+            );
             Answer::Done(kept.map_err(|_| AtomError::Invalid))
         }
         R::GetCollisionMode => byte(settings.collision().enabled()),
@@ -485,9 +494,10 @@ fn execute<I: AtomIo>(
             if changed.set_threshold(joint.get(), threshold.get()).is_err() {
                 return Answer::Done(Err(AtomError::Invalid));
             }
-            let kept = settings
-                .collision_mut()
-                .replace_kept(changed, io.param_store());
+            let kept = settings.collision_mut().replace_kept(
+                changed,
+                flash_writes.over(io.param_store()).as_mut().map(as_store),
+            );
             Answer::Done(kept.map_err(|_| AtomError::Invalid))
         }
         R::GetCollisionThresholds => Answer::Now(Reply::Bytes6(settings.collision().thresholds())),

@@ -71,6 +71,7 @@ pub mod dispenser;
 pub mod drag;
 pub mod driver;
 pub mod error;
+pub mod flash_writes;
 mod gains;
 mod gripper;
 pub mod health;

@@ -8,6 +8,7 @@ use crate::context::Context;
 use crate::dispenser::Dispenser;
 use crate::drag::DragRecorder;
 use crate::error::{AtomError, ErrorLog};
+use crate::flash_writes::FlashWrites;
 use crate::gripper::Gripper;
 use crate::motion::MotionController;
 use crate::settings::Settings;
@@ -34,6 +35,8 @@ pub struct Parts {
     pub waiting: WaitingReads,
     /// Collision detection.
     pub collision: CollisionDetector,
+    /// Records waiting to be written to flash until the arm is quiet.
+    pub flash_writes: FlashWrites,
 }
 
 impl Parts {
@@ -48,6 +51,7 @@ impl Parts {
             errors: ErrorLog::default(),
             waiting: WaitingReads::default(),
             collision: CollisionDetector::default(),
+            flash_writes: FlashWrites::default(),
             settings,
         }
     }

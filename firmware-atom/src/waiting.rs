@@ -76,6 +76,11 @@ pub struct WaitingReads {
 }
 
 impl WaitingReads {
+    /// True if no request waits for its reads.
+    pub fn is_empty(&self) -> bool {
+        self.waiters.iter().all(Option::is_none)
+    }
+
     /// Queues `ops` in `bank` for a request from `link` that waits as `read`. Refused
     /// ([`AtomError::Busy`]) while one of its kind runs that must run alone, or without room.
     pub fn start(

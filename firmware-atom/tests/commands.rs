@@ -820,6 +820,8 @@ fn backup_and_restore_bring_back_a_servos_parameters_after_a_restart() {
     let mut rig = Rig::new();
     assert_eq!(rig.ask(0xEB, &[2]), [0], "no backup yet: restore refused");
     assert_eq!(rig.ask(0xEA, &[254]), [1], "backup of every joint");
+    // The backups reach the flash once the arm has been quiet for 20 ms.
+    rig.run_ms(50);
     // Someone changes joint 2's P gain and dead zone...
     assert_eq!(rig.ask(0x52, &[2, 21, 40]), [1]);
     assert_eq!(rig.ask(0x52, &[2, 26, 9]), [1]);

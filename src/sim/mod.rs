@@ -8,6 +8,8 @@
 //! * [`contact`]: obstacles in a joint's way (`--obstacle J:DEG`).
 //! * [`reply_faults`]: a servo's answers late or lost (`--late-replies ID:US`,
 //!   `--lost-replies ID:PER_MILLE`).
+//! * [`busy_client`]: a client that sends request after request and counts late and lost
+//!   answers.
 //! * [`external`]: the same bus and servos serving boards that run elsewhere (the real images on
 //!   an emulated chip), whole frames in and the bus's bytes, echo included, out.
 //! * [`VirtualRobot`]: the real `firmware_basic::Basic` and `firmware_atom::Atom` wired to seven
@@ -45,6 +47,7 @@
 
 pub mod arg_error;
 mod basic_flash;
+pub mod busy_client;
 pub mod contact;
 pub mod external;
 pub mod flash_timing;
@@ -55,6 +58,7 @@ mod robot;
 pub use sim_hw::{servo, wire};
 
 pub use basic_flash::{BASIC_FLASH_BYTES, BasicFlash, BasicFlashStore};
+pub use busy_client::BusyClient;
 pub use flash_timing::FlashTiming;
 pub use robot::{
     AskError, HostLink, NET_BUFFER_BYTES, NetClient, POLL_PERIOD_NS, RobotConfig, SERVO_IDS,
