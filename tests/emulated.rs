@@ -3,7 +3,10 @@
 //! the exact board images on emulated chips, started by tools/emulate with Espressif's QEMU:
 //! the ESP32 images when `ESP_QEMU_XTENSA` names its `qemu-system-xtensa`, the ESP32-C3 images
 //! when `ESP_QEMU_RISCV32` names its `qemu-system-riscv32`. Without either it says so in one
-//! line and passes (CI has no emulator). It prints, per image, what passed.
+//! line and passes (CI has no emulator). It prints, per image, what passed. The machine is
+//! tools/emulate's choice, so the test and a person running tools/emulate see the same one:
+//! `esp32-picsimlab` where the ESP32 emulator has it (PICSimLab's fork), else `esp32`
+//! (`ESP_QEMU_MACHINE_ESP32` overrides it); `esp32c3` for the C3.
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
 use std::io::{BufRead, BufReader, Write};

@@ -9,15 +9,19 @@
 #![cfg_attr(not(test), no_std)]
 #![deny(unsafe_code)]
 
+#[cfg(target_os = "none")]
+pub mod clock;
 pub mod deadline;
 #[cfg(target_os = "none")]
 pub mod uart_port;
 #[cfg(target_os = "none")]
 pub mod watchdog;
 
+#[cfg(target_os = "none")]
+pub use clock::now_us;
 pub use deadline::{Deadline, TimedOut, wait_until};
 #[cfg(target_os = "none")]
-pub use uart_port::{UartPort, now_us};
+pub use uart_port::UartPort;
 #[cfg(target_os = "none")]
 pub use watchdog::LoopWatchdog;
 

@@ -3,12 +3,14 @@
 
 use esp_hal::{
     Blocking,
-    time::Instant,
     uart::{Config, Uart},
 };
 use protocol_core::{BytePort, timing::wire_time_us};
 
-use crate::deadline::{Deadline, wait_until};
+use crate::{
+    clock::now_us,
+    deadline::{Deadline, wait_until},
+};
 
 /// Bytes the UART's transmit FIFO holds (both chips).
 const TX_FIFO_BYTES: u32 = 128;
@@ -50,11 +52,6 @@ impl<'d> UartPort<'d> {
             tx_done_at_us: 0,
         }
     }
-}
-
-/// Microseconds since boot.
-pub fn now_us() -> u64 {
-    Instant::now().duration_since_epoch().as_micros()
 }
 
 impl BytePort for UartPort<'_> {

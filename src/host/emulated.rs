@@ -153,7 +153,7 @@ impl RealtimeRobot for EmulatedBoards {
         for (board, chardev) in &mut self.buses {
             self.scratch.clear();
             chardev.read_into(&mut self.scratch);
-            self.arm.board_sent(*board, &self.scratch);
+            self.arm.board_sent(*board, t_us, &self.scratch);
         }
         self.arm.run_until(t_us);
         for (board, chardev) in &mut self.buses {

@@ -211,10 +211,18 @@ impl EmulatedArm {
         self.now_ns / 1_000
     }
 
-    /// Bytes `board` sent on its bus UART, arriving now; they go on the wire as whole frames.
-    pub fn board_sent(&mut self, board: BoardId, bytes: &[u8]) {
+    /// Bytes `board` sent on its bus UART, read from its socket at `arrived_us` (virtual time,
+    /// at least [`EmulatedArm::now_us`]); they go on the wire as whole frames, from the arm's
+    /// present instant on. An unfinished frame goes stale [`STALE_AFTER_NS`] after its bytes
+    /// arrived, not after the arm's last step: the loop that reads the sockets sleeps up to 5 ms
+    /// while the line is quiet, so the last step can be that old when a board starts a frame,
+    /// and counted from it the first chunk was stale at once and went on the wire alone (a
+    /// backup's reply, after the Atom's 60 ms of quiet flash work, reached the Basic as `FE`
+    /// and, 1.5 ms later, `FE 03 EA 00 FA`: cut by the 200 us gap, dropped, never answered).
+    pub fn board_sent(&mut self, board: BoardId, arrived_us: u64, bytes: &[u8]) {
+        let arrived_ns = arrived_us.saturating_mul(1_000).max(self.now_ns);
         if let Some(b) = self.boards.get_mut(board.0) {
-            b.gate.push(self.now_ns, bytes);
+            b.gate.push(arrived_ns, bytes);
         }
     }
 
@@ -340,9 +348,9 @@ mod tests {
         arm.run_until(100);
         // READ servo 1, present position (0x38), 2 bytes.
         let read = [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE];
-        arm.board_sent(atom, &read[..3]);
+        arm.board_sent(atom, 100, &read[..3]);
         arm.run_until(150);
-        arm.board_sent(atom, &read[3..]);
+        arm.board_sent(atom, 150, &read[3..]);
         arm.run_until(2_000);
         let mut heard = Vec::new();
         arm.board_received(atom, &mut heard);
@@ -358,11 +366,11 @@ mod tests {
         let atom = arm.attach_board(0);
         let basic = arm.attach_board(60);
         // The Basic's frame goes stale while the Atom keeps the line busy with 40 us gaps.
-        arm.board_sent(basic, &[0xFE, 0xFE, 0x02]);
+        arm.board_sent(basic, 0, &[0xFE, 0xFE, 0x02]);
         let ping = [0xFF, 0xFF, 0x09, 0x02, 0x01, 0xF3]; // no servo 9: nobody answers
         let mut t = 0;
         while t < STALE_AFTER_NS / 1_000 + 2_000 {
-            arm.board_sent(atom, &ping);
+            arm.board_sent(atom, t, &ping);
             t += 100; // 60 us of packet, 40 us of gap
             arm.run_until(t);
         }
@@ -376,11 +384,11 @@ mod tests {
         let atom = arm.attach_board(0);
         let basic = arm.attach_board(60);
         arm.run_until(100);
-        arm.board_sent(atom, &[0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE]);
+        arm.board_sent(atom, 100, &[0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE]);
         arm.run_until(120);
         // The Basic's frame arrives while the Atom's packet is on the wire.
         let get_angles = [0xFE, 0xFE, 0x02, 0x20, 0xFA];
-        arm.board_sent(basic, &get_angles);
+        arm.board_sent(basic, 120, &get_angles);
         arm.run_until(3_000);
         let mut atom_heard = Vec::new();
         arm.board_received(atom, &mut atom_heard);
@@ -395,5 +403,25 @@ mod tests {
             Some(&get_angles[..]),
             "then the Basic's frame"
         );
+    }
+
+    #[test]
+    fn a_frame_started_after_a_quiet_spell_goes_on_the_wire_whole() {
+        let mut arm = EmulatedArm::new(1, 2048);
+        let atom = arm.attach_board(0);
+        let basic = arm.attach_board(60);
+        arm.run_until(100);
+        // The line was quiet, the loop slept 5 ms; the Atom's reply comes in two chunks.
+        let reply = [0xFE, 0xFE, 0x03, 0xEA, 0x00, 0xFA];
+        arm.board_sent(atom, 5_100, &reply[..1]);
+        arm.run_until(5_100);
+        arm.run_until(5_300);
+        let mut heard = Vec::new();
+        arm.board_received(basic, &mut heard);
+        assert!(heard.is_empty(), "the first byte went alone: {heard:02X?}");
+        arm.board_sent(atom, 6_600, &reply[1..]);
+        arm.run_until(8_000);
+        arm.board_received(basic, &mut heard);
+        assert_eq!(heard, reply);
     }
 }

@@ -43,6 +43,7 @@ esp_bootloader_esp_idf::esp_app_desc!();
 #[main]
 fn main() -> ! {
     let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
+    board_support::clock::start(&p);
     // Armed before anything that could hang: from here on only the loop below feeds it.
     let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, p.TIMG1, now_us());
     let pins = pins::chip::take_pins!(p);

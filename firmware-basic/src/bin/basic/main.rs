@@ -82,6 +82,7 @@ const HEAP_BYTES: usize = 36 * 1024;
 #[main]
 fn main() -> ! {
     let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
+    board_support::clock::start(&p);
     // Armed before anything that could hang (the LCD's set-up, the Wi-Fi scheduler and radio):
     // from here on only the loop below feeds it.
     let mut watchdog = LoopWatchdog::start(p.RTC_TIMER, p.TIMG1, now_us());
