@@ -12,30 +12,49 @@
 use open_mycobot::sim::{BusyClient, FlashTiming, HostLink, RobotConfig, VirtualRobot};
 use protocol_core::command::{CollisionThreshold, JointId, Request, ServoSelect};
 
-fn run(timing: FlashTiming, seconds: u64) {
+/// What the writing client writes, over and over.
+#[derive(Clone, Copy, Debug)]
+enum Writes {
+    /// Collision thresholds (each a new value) and a backup of every servo: the Atom's flash.
+    AtomSettings,
+    /// The Wi-Fi server port, two values in turn: the Basic's flash.
+    WifiPort,
+}
+
+impl Writes {
+    fn requests(self) -> Vec<Request> {
+        match self {
+            Self::AtomSettings => (0..20u8)
+                .map(|i| {
+                    if i % 4 == 3 {
+                        Request::BackupServoParams {
+                            servo: ServoSelect::All,
+                        }
+                    } else {
+                        Request::SetCollisionThreshold {
+                            joint: JointId::new(1 + i % 6).unwrap(),
+                            threshold: CollisionThreshold::new(60 + 9 * i).unwrap(),
+                        }
+                    }
+                })
+                .collect(),
+            Self::WifiPort => [9_001, 9_002]
+                .map(|port| Request::SetServerPort { port })
+                .to_vec(),
+        }
+    }
+}
+
+fn run(timing: FlashTiming, writes: Writes, seconds: u64) {
     let mut robot = VirtualRobot::new(RobotConfig {
         flash_timing: timing,
         ..RobotConfig::default()
     });
     robot.run_for(1_500_000);
     let poller = |link| BusyClient::new(link, vec![Request::GetAngles]);
-    let writes = (0..20u8)
-        .map(|i| {
-            if i % 4 == 3 {
-                Request::BackupServoParams {
-                    servo: ServoSelect::All,
-                }
-            } else {
-                Request::SetCollisionThreshold {
-                    joint: JointId::new(1 + i % 6).unwrap(),
-                    threshold: CollisionThreshold::new(60 + 9 * i).unwrap(),
-                }
-            }
-        })
-        .collect();
     let usb = poller(HostLink::Basic);
     let net = poller(robot.connect().unwrap());
-    let writer = BusyClient::new(robot.connect().unwrap(), writes);
+    let writer = BusyClient::new(robot.connect().unwrap(), writes.requests());
     let mut clients = [usb, net, writer];
     let end = robot.now_us() + seconds * 1_000_000;
     while robot.now_us() < end {
@@ -44,14 +63,10 @@ fn run(timing: FlashTiming, seconds: u64) {
         }
         robot.run_for(100);
     }
-    println!("flash timing {timing:?}, {seconds} s:");
-    for (name, c) in [
-        "get_angles (USB)",
-        "get_angles (TCP)",
-        "thresholds + backups",
-    ]
-    .iter()
-    .zip(&clients)
+    println!("flash timing {timing:?}, writes {writes:?}, {seconds} s:");
+    for (name, c) in ["get_angles (USB)", "get_angles (TCP)", "writes"]
+        .iter()
+        .zip(&clients)
     {
         println!(
             "  {name:22} {:6} answered, {:3} late > 400 ms, {:3} lost (> 0.5 s), slowest {:6.1} ms   (target: 0 late, 0 lost)",
@@ -68,11 +83,13 @@ fn main() {
         .skip(1)
         .find_map(|a| a.parse().ok())
         .unwrap_or(10);
-    for timing in [
-        FlashTiming::Instant,
-        FlashTiming::Typical,
-        FlashTiming::Worst,
-    ] {
-        run(timing, seconds);
+    for writes in [Writes::AtomSettings, Writes::WifiPort] {
+        for timing in [
+            FlashTiming::Instant,
+            FlashTiming::Typical,
+            FlashTiming::Worst,
+        ] {
+            run(timing, writes, seconds);
+        }
     }
 }
