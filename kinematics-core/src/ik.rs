@@ -149,29 +149,27 @@ impl FlangeInFrame1 {
         }
     }
 
-    /// Frame 4 seen from frame 1 at the wrist angles (sin t5, cos t5) and (sin t6, cos t6), Q30:
-    /// (t2 + t3 + t4, origin x, origin y).
+    /// The rotation of frame 4 seen from frame 1, t2 + t3 + t4, at the wrist angles
+    /// (sin t5, cos t5) and (sin t6, cos t6) (Q30).
     ///
-    /// T14 = M * A56^-1, of which only the rotation's first column and the position's x and y
-    /// are needed. For A5 = Rz(t5) * Tz(d5) * Rx(-90 deg) and A6 = Rz(t6) * Tz(d6), row 0 of R56
-    /// is (c5 c6, -c5 s6, -s5) and R56^T * p56 = (-d5 s6, -d5 c6, d6), so
-    /// R14 e_x = M.R * (c5 c6, -c5 s6, -s5) and p14 = M.p - M.R * (-d5 s6, -d5 c6, d6).
-    fn frame4(
-        &self,
-        (s5, c5): (i64, i64),
-        (s6, c6): (i64, i64),
-        d5: Len,
-        d6: Len,
-    ) -> (Angle, Len, Len) {
+    /// T14 = M * A56^-1, with A5 = Rz(t5) * Tz(d5) * Rx(-90 deg) and A6 = Rz(t6) * Tz(d6). Its
+    /// x axis is M.R times row 0 of R56, (c5 c6, -c5 s6, -s5).
+    fn frame4_angle(&self, (s5, c5): (i64, i64), (s6, c6): (i64, i64)) -> Angle {
         let [row0, row1, _] = &self.rotation;
         let x_axis = [mul(c5, c6), -mul(c5, s6), -s5];
+        atan2(dot(row1, &x_axis), dot(row0, &x_axis))
+    }
+
+    /// The origin of frame 4 seen from frame 1 (x, y) at the wrist angle (sin t6, cos t6) (Q30),
+    /// for the wrist offsets `d5` and `d6`; it does not depend on t5.
+    ///
+    /// p14 = M.p - M.R * R56^T * p56, and R56^T * p56 = (-d5 s6, -d5 c6, d6) (see
+    /// [`FlangeInFrame1::frame4_angle`] for A5 and A6).
+    fn frame4_origin(&self, (s6, c6): (i64, i64), d5: Len, d6: Len) -> [Len; 2] {
+        let [row0, row1, _] = &self.rotation;
         let wrist = [-mul(d5, s6), -mul(d5, c6), d6];
         let [ox, oy] = self.origin;
-        (
-            atan2(dot(row1, &x_axis), dot(row0, &x_axis)),
-            ox - dot(row0, &wrist),
-            oy - dot(row1, &wrist),
-        )
+        [ox - dot(row0, &wrist), oy - dot(row1, &wrist)]
     }
 }
 
@@ -266,7 +264,8 @@ pub(crate) fn solve(
 
     let (s_len, d_len) = (a2.abs() + a3.abs(), (a2.abs() - a3.abs()).abs());
     // |e|^2 the seed's elbow angle reaches.
-    let seed_l2 = a2 * a2 + a3 * a3 + 2 * a2 * mul(a3, seed_theta3.sin_cos().1);
+    let seed_sin_cos3 = seed_theta3.sin_cos();
+    let seed_l2 = a2 * a2 + a3 * a3 + 2 * a2 * mul(a3, seed_sin_cos3.1);
     let cos_sign = if (a2 < 0) == (a3 < 0) { 1 } else { -1 };
     let mut out: Branches = [None; MAX_BRANCHES];
     let mut degenerate = false;
@@ -282,19 +281,42 @@ pub(crate) fn solve(
         // The flange in frame 1: its z axis is (-s5 c234, -s5 s234, c5) and the last row of its
         // rotation (s5 c6, -s5 s6, c5).
         let m = FlangeInFrame1::new(target, s1, c1, d1);
-        let [[_, _, x1], [_, _, y1], [cos6, minus_sin6, c5]] = m.rotation;
+        let [[_, _, x1], [_, _, y1], [s5_cos6, minus_s5_sin6, c5]] = m.rotation;
         let s5 = sqrt(x1 * x1 + y1 * y1);
+        let free_t6 = s5 < WRIST_SINGULAR_SIN;
+        // Wrist 0 has sin t5 >= 0. Wrist 1 negates t5, which turns t6 by half a turn (unless t6
+        // is free), and with it t234 (so the x axis of frame 4 is the same).
+        let t5_up = atan2(s5, c5);
+        let t6_up = if free_t6 {
+            seed_theta6
+        } else {
+            atan2(-minus_s5_sin6, s5_cos6)
+        };
+        let (sin6, cos6) = t6_up.sin_cos();
+        let t234_up = m.frame4_angle((s5, c5), (sin6, cos6));
+        let origin_up = m.frame4_origin((sin6, cos6), d5, d6);
         for (wrist, sign5) in [1i64, -1].into_iter().enumerate() {
-            let t5 = atan2(sign5 * s5, c5);
-            let free_t6 = s5 < WRIST_SINGULAR_SIN;
-            let mut t6 = if free_t6 {
-                seed_theta6
-            } else {
-                atan2(-sign5 * minus_sin6, sign5 * cos6)
-            };
             // (sin t5, cos t5) up to the length of z (1 within the rotation's rounding).
-            let frame4 = |t6: Angle| m.frame4((sign5 * s5, c5), t6.sin_cos(), d5, d6);
-            let (mut t234, mut ex, mut ey) = frame4(t6);
+            let sin_cos5 = (sign5 * s5, c5);
+            let (t5, mut t6, mut t234, [mut ex, mut ey]) = if wrist == 0 {
+                (t5_up, t6_up, t234_up, origin_up)
+            } else if free_t6 {
+                let t234 = m.frame4_angle(sin_cos5, (sin6, cos6));
+                (t5_up.neg(), t6_up, t234, origin_up)
+            } else {
+                let origin = m.frame4_origin((-sin6, -cos6), d5, d6);
+                (
+                    t5_up.neg(),
+                    t6_up.add(Angle::HALF),
+                    t234_up.add(Angle::HALF),
+                    origin,
+                )
+            };
+            let frame4 = |t6: Angle| {
+                let sin_cos6 = t6.sin_cos();
+                let [ex, ey] = m.frame4_origin(sin_cos6, d5, d6);
+                (m.frame4_angle(sin_cos5, sin_cos6), ex, ey)
+            };
             // Near the wrist singularity t6 moves the frame-4 origin on a d5 circle. If this t6
             // puts it out of the elbow's reach by more than the wire's rounding, treat t6 as
             // free: start from the seed's and turn to the nearest t6 that reaches. Inside the
@@ -342,18 +364,27 @@ pub(crate) fn solve(
             let sin3 = sqrt(s_len * s_len - l2) * sqrt(l2 - d_len * d_len);
             let cos3 = cos_sign * (l2 - a2 * a2 - a3 * a3);
             let toward_e = atan2(ey, ex);
-            // Next to the stretched elbow t3 is ill-conditioned too: keep the seed's t3 if it
-            // reaches within SEED_SLACK of |e| and lies on this branch's side.
-            for (elbow, sign3) in [1i64, -1].into_iter().enumerate() {
-                let mut t3 = atan2(sign3 * sin3, cos3);
-                if near(seed_theta3, t3)
-                    && (seed_theta3.0 >= 0) == (t3.0 >= 0)
+            // Elbow 0 has sin t3 >= 0; elbow 1 mirrors it, negating t3 and the angle of e seen
+            // from frame 2, (a2 + a3 c3, a3 s3).
+            let t3_up = atan2(sin3, cos3);
+            let (s3, c3) = t3_up.sin_cos();
+            let e_in_frame2_up = atan2(mul(a3, s3), a2 + mul(a3, c3));
+            for (elbow, nominal_t3, nominal_e_in_frame2) in [
+                (0, t3_up, e_in_frame2_up),
+                (1, t3_up.neg(), e_in_frame2_up.neg()),
+            ] {
+                // Next to the stretched elbow t3 is ill-conditioned too: keep the seed's t3 if
+                // it reaches within SEED_SLACK of |e| and lies on this branch's side.
+                let (t3, e_in_frame2) = if near(seed_theta3, nominal_t3)
+                    && (seed_theta3.0 >= 0) == (nominal_t3.0 >= 0)
                     && (seed_l2 - l2).abs() <= 2 * sqrt(l2) * SEED_SLACK
                 {
-                    t3 = seed_theta3;
-                }
-                let (s3, c3) = t3.sin_cos();
-                let t2 = toward_e.sub(atan2(mul(a3, s3), a2 + mul(a3, c3)));
+                    let (s3, c3) = seed_sin_cos3;
+                    (seed_theta3, atan2(mul(a3, s3), a2 + mul(a3, c3)))
+                } else {
+                    (nominal_t3, nominal_e_in_frame2)
+                };
+                let t2 = toward_e.sub(e_in_frame2);
                 let t4 = t234.sub(t2).sub(t3);
                 let ill_conditioned = [phi, t3, t5, t5.sub(Angle::HALF)]
                     .iter()
