@@ -365,10 +365,10 @@ pub(crate) fn solve(
             let cos3 = cos_sign * (l2 - a2 * a2 - a3 * a3);
             let toward_e = atan2(ey, ex);
             // Elbow 0 has sin t3 >= 0; elbow 1 mirrors it, negating t3 and the angle of e seen
-            // from frame 2, (a2 + a3 c3, a3 s3).
+            // from frame 2, (a2 + a3 c3, a3 s3): times 2 |a2 a3| / |a3| that is
+            // (2 |a2| a2 + sgn(a3) cos3, sgn(a3) sin3), so it needs no sine and cosine of t3.
             let t3_up = atan2(sin3, cos3);
-            let (s3, c3) = t3_up.sin_cos();
-            let e_in_frame2_up = atan2(mul(a3, s3), a2 + mul(a3, c3));
+            let e_in_frame2_up = atan2(a3.signum() * sin3, 2 * a2.abs() * a2 + a3.signum() * cos3);
             for (elbow, nominal_t3, nominal_e_in_frame2) in [
                 (0, t3_up, e_in_frame2_up),
                 (1, t3_up.neg(), e_in_frame2_up.neg()),
