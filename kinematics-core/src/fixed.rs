@@ -2,8 +2,9 @@
 //!
 //! Nothing here uses floating point. Ratios are Q30 (`1 << 30` = 1.0) held in `i64`, angles are
 //! binary angles ([`Angle`], 2^32 per turn), so adding angles wraps around the circle for free.
-//! Accuracy: sine and cosine within 2e-9, `atan2` within 1e-9 rad (both well below the 0.01 deg
-//! wire resolution, 1.7e-4 rad); the tests compare against `libm` over the whole circle.
+//! Accuracy: sine and cosine within 2e-9, `atan2` within 2e-9 rad (1.3 binary-angle units; both
+//! well below the 0.01 deg wire resolution, 1.7e-4 rad); the tests compare against `libm` over
+//! the whole circle.
 
 use core::num::NonZeroU64;
 
@@ -14,24 +15,72 @@ pub const ONE: i64 = 1 << 30;
 const PI_Q30: i64 = 3_373_259_426;
 /// Binary angle of a quarter turn.
 const QUARTER_TURN: i64 = 1 << 30;
-/// atan(k / 16) for k = 0..=16 in binary-angle units (round(atan(k/16) * 2^32 / (2 pi))).
-const ATAN_SIXTEENTHS: [i64; 17] = [
+/// atan(k / 64) for k = 0..=64 in binary-angle units (round(atan(k/64) * 2^32 / (2 pi))).
+const ATAN_SIXTY_FOURTHS: [u32; 65] = [
     0,
+    10_679_838,
+    21_354_465,
+    32_018_685,
     42_667_331,
+    53_295_284,
+    63_897_482,
+    74_468_939,
     85_004_756,
+    95_500_135,
+    105_950_391,
+    116_350_962,
     126_697_423,
+    136_985_493,
+    147_211_045,
+    157_370_116,
     167_458_907,
+    177_473_799,
+    187_411_349,
+    197_268_300,
     207_041_579,
+    216_728_303,
+    226_325_781,
+    235_831_508,
     245_243_172,
+    254_558_647,
+    263_775_993,
+    272_893_455,
     281_909_457,
+    290_822_599,
+    299_631_651,
+    308_335_554,
     316_933_406,
+    325_424_463,
+    333_808_132,
+    342_083_962,
     350_251_643,
+    358_310_992,
+    366_261_957,
+    374_104_599,
     381_839_095,
+    389_465_727,
+    396_984_877,
+    404_397_019,
     411_702_716,
+    418_902_610,
+    425_997_422,
+    432_987_938,
     439_875_013,
+    446_659_557,
+    453_342_536,
+    459_924_966,
     466_407_904,
+    472_792_449,
+    479_079_736,
+    485_270_931,
     491_367_227,
+    497_369_841,
+    503_280_012,
+    509_098_996,
     514_828_063,
+    520_468_494,
+    526_021_581,
+    531_488_619,
     536_870_912,
 ];
 /// Centidegrees in a full turn.
@@ -135,15 +184,10 @@ fn cos_small(x: i64) -> i64 {
 /// Bits to keep in the larger operand of [`atan2`] so that `min << 30` fits an `i64`.
 const ATAN_INPUT_BITS: u32 = 32;
 
-/// atan(u) = u - u^3/3 + u^5/5 - u^7/7 in binary-angle units times 2^7: the coefficients
-/// round(2^32 / (2 pi) * 2^7 / (2k + 1)) for k = 0..=3. For 0 <= u < 1/16 the terms dropped (from
-/// u^9/9) stay below 2e-12 rad, and u times the first fits an `i64`.
-const ATAN_SERIES_BAM_Q7: [u64; 4] = [
-    87_496_355_274,
-    29_165_451_758,
-    17_499_271_055,
-    12_499_479_325,
-];
+/// atan(u) = u - u^3/3 + u^5/5 in binary-angle units times 2^7: round(2^32 / (2 pi) * 2^7 / n)
+/// for n = 1, 3, 5. For 0 <= u < 1/64 the terms dropped (from u^7/7) stay below 1e-14 rad, and u
+/// (Q32) times the first fits a `u64`.
+const ATAN_SERIES_BAM_Q7: [u64; 3] = [87_496_355_274, 29_165_451_758, 17_499_271_055];
 
 /// The angle of the vector (x, y) (any common scale); 0 for the zero vector.
 pub fn atan2(y: i64, x: i64) -> Angle {
@@ -157,20 +201,19 @@ pub fn atan2(y: i64, x: i64) -> Angle {
     let Some(big_kept) = NonZeroU64::new(big >> excess) else {
         return Angle::ZERO;
     };
-    // t = small / big in [0, 1], Q30.
-    let t = ((small >> excess) << 30) / big_kept;
-    // The sixteenth c = k/16 at or below t, then atan(t) = atan(c) + atan(u) with
-    // u = (t - c) / (1 + t c) in [0, 1/16).
-    let k = t >> 26;
-    let c = k << 26;
-    let u = ((t - c) << 30)
-        .checked_div((1 << 30) + ((t * c) >> 30))
+    let small = small >> excess;
+    // The sixty-fourth c = k/64 at or below small / big, then atan(small / big) = atan(c) + atan(u)
+    // with u = (small - c big) / (big + c small) in [0, 1/64), Q32 (small - c big < big < 2^32).
+    let k = (small << 6) / big_kept;
+    let big = big_kept.get();
+    let u = (((small << 6) - k * big) << 32)
+        .checked_div((big << 6) + k * small)
         .unwrap_or(0);
-    let u2 = (u * u) >> 30;
-    let [p1, p3, p5, p7] = ATAN_SERIES_BAM_Q7;
-    let series = p1 - ((u2 * (p3 - ((u2 * (p5 - ((u2 * p7) >> 30))) >> 30))) >> 30);
-    let base = ATAN_SIXTEENTHS.get(k as usize).copied().unwrap_or(0);
-    let mut a = base + ((u * series + (1 << 36)) >> 37) as i64;
+    let u2 = (u * u) >> 32;
+    let [p1, p3, p5] = ATAN_SERIES_BAM_Q7;
+    let series = p1 - ((u2 * (p3 - ((u2 * p5) >> 32))) >> 32);
+    let base = ATAN_SIXTY_FOURTHS.get(k as usize).copied().unwrap_or(0);
+    let mut a = i64::from(base) + ((u * series + (1 << 38)) >> 39) as i64;
     if swapped {
         a = QUARTER_TURN - a;
     }
@@ -279,6 +322,14 @@ mod tests {
             }
         }
         assert!(worst < 1e-8, "worst atan2 error {worst} rad");
+    }
+
+    #[test]
+    fn atan_table_matches_libm() {
+        for (k, &entry) in ATAN_SIXTY_FOURTHS.iter().enumerate() {
+            let want = libm::atan(k as f64 / 64.0) * 4_294_967_296.0 / core::f64::consts::TAU;
+            assert_eq!(i64::from(entry), libm::round(want) as i64, "atan({k}/64)");
+        }
     }
 
     #[test]
