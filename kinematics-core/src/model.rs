@@ -232,12 +232,14 @@ impl Kinematics {
                 self.limits.max.get(joint).copied().unwrap_or(0),
             );
             let seed = seed.0.get(joint).copied().unwrap_or(0);
+            // wrap_into moves q by the turns that bring it nearest the seed clamped into the
+            // limits; none when that seed - q is in [-180, 180) deg.
+            let seed_in_limits = seed.clamp(min, max.max(min));
             Placement {
                 offset: self.links.offset.get(joint).copied().unwrap_or(Angle::ZERO),
-                min,
-                max,
                 seed,
-                seed_in_limits: seed.clamp(min, max.max(min)),
+                kept_from: min.max(seed_in_limits.saturating_sub(HALF_TURN_CENTIDEG - 1)),
+                kept_to: max.min(seed_in_limits.saturating_add(HALF_TURN_CENTIDEG)),
             }
         })
     }
@@ -271,9 +273,7 @@ impl Kinematics {
         let q = theta.sub(placement.offset).to_centideg();
         // What wrap_into gives when q itself is the turn nearest the seed and fits, without its
         // division; any other case goes to wrap_into.
-        let to_seed = i64::from(placement.seed_in_limits) - i64::from(q);
-        let nearest_turn = (-HALF_TURN_CENTIDEG..HALF_TURN_CENTIDEG).contains(&to_seed);
-        let angle = if nearest_turn && (placement.min..=placement.max).contains(&q) {
+        let angle = if (placement.kept_from..=placement.kept_to).contains(&q) {
             q
         } else {
             self.limits.wrap_into(joint, q, placement.seed)?
@@ -284,23 +284,21 @@ impl Kinematics {
 }
 
 /// Half a turn in centidegrees.
-const HALF_TURN_CENTIDEG: i64 = 18_000;
+const HALF_TURN_CENTIDEG: i32 = 18_000;
 
-/// What choosing a joint's angle needs, computed once per solve: its DH offset, its limits and
-/// the seed's angle, as given (for the distance) and clamped into the limits as
-/// [`JointLimits::wrap_into`] does (to choose the turn).
+/// What choosing a joint's angle needs, computed once per solve: its DH offset, the seed's
+/// angle, and the protocol angles that [`JointLimits::wrap_into`] keeps as they are (within the
+/// limits and less than half a turn from the seed clamped into them).
 #[derive(Clone, Copy, Debug)]
 struct Placement {
     /// DH angle at protocol angle 0.
     offset: Angle,
-    /// Lowest allowed angle, centidegrees.
-    min: i32,
-    /// Highest allowed angle, centidegrees.
-    max: i32,
     /// The seed's angle, centidegrees.
     seed: i32,
-    /// The seed's angle clamped into the limits.
-    seed_in_limits: i32,
+    /// Lowest angle kept as it is, centidegrees.
+    kept_from: i32,
+    /// Highest angle kept as it is, centidegrees.
+    kept_to: i32,
 }
 
 /// A transform paired with its inverse.
