@@ -2,36 +2,85 @@
 //!
 //! Nothing here uses floating point. Ratios are Q30 (`1 << 30` = 1.0) held in `i64`, angles are
 //! binary angles ([`Angle`], 2^32 per turn), so adding angles wraps around the circle for free.
-//! Accuracy: sine and cosine within 2e-9, `atan2` within 1e-9 rad (both well below the 0.01 deg
-//! wire resolution, 1.7e-4 rad); the tests compare against `libm` over the whole circle.
+//! Accuracy: sine and cosine within 2e-9, `atan2` within 2e-9 rad (1.3 binary-angle units; both
+//! well below the 0.01 deg wire resolution, 1.7e-4 rad); the tests compare against `libm` over
+//! the whole circle.
+
+use core::num::NonZeroU64;
 
 /// 1.0 in Q30.
 pub const ONE: i64 = 1 << 30;
 
 /// pi in Q30 (round(pi * 2^30)).
 const PI_Q30: i64 = 3_373_259_426;
-/// Binary-angle units per radian, Q8 (round(2^32 / (2 pi) * 2^8)); Q8 keeps `poly * this` in i64.
-const BAM_PER_RAD_Q8: i64 = 174_992_710_548;
 /// Binary angle of a quarter turn.
 const QUARTER_TURN: i64 = 1 << 30;
-/// atan(k / 16) for k = 0..=16 in binary-angle units (round(atan(k/16) * 2^32 / (2 pi))).
-const ATAN_SIXTEENTHS: [i64; 17] = [
+/// atan(k / 64) for k = 0..=64 in binary-angle units (round(atan(k/64) * 2^32 / (2 pi))).
+const ATAN_SIXTY_FOURTHS: [u32; 65] = [
     0,
+    10_679_838,
+    21_354_465,
+    32_018_685,
     42_667_331,
+    53_295_284,
+    63_897_482,
+    74_468_939,
     85_004_756,
+    95_500_135,
+    105_950_391,
+    116_350_962,
     126_697_423,
+    136_985_493,
+    147_211_045,
+    157_370_116,
     167_458_907,
+    177_473_799,
+    187_411_349,
+    197_268_300,
     207_041_579,
+    216_728_303,
+    226_325_781,
+    235_831_508,
     245_243_172,
+    254_558_647,
+    263_775_993,
+    272_893_455,
     281_909_457,
+    290_822_599,
+    299_631_651,
+    308_335_554,
     316_933_406,
+    325_424_463,
+    333_808_132,
+    342_083_962,
     350_251_643,
+    358_310_992,
+    366_261_957,
+    374_104_599,
     381_839_095,
+    389_465_727,
+    396_984_877,
+    404_397_019,
     411_702_716,
+    418_902_610,
+    425_997_422,
+    432_987_938,
     439_875_013,
+    446_659_557,
+    453_342_536,
+    459_924_966,
     466_407_904,
+    472_792_449,
+    479_079_736,
+    485_270_931,
     491_367_227,
+    497_369_841,
+    503_280_012,
+    509_098_996,
     514_828_063,
+    520_468_494,
+    526_021_581,
+    531_488_619,
     536_870_912,
 ];
 /// Centidegrees in a full turn.
@@ -135,6 +184,11 @@ fn cos_small(x: i64) -> i64 {
 /// Bits to keep in the larger operand of [`atan2`] so that `min << 30` fits an `i64`.
 const ATAN_INPUT_BITS: u32 = 32;
 
+/// atan(u) = u - u^3/3 + u^5/5 in binary-angle units times 2^7: round(2^32 / (2 pi) * 2^7 / n)
+/// for n = 1, 3, 5. For 0 <= u < 1/64 the terms dropped (from u^7/7) stay below 1e-14 rad, and u
+/// (Q32) times the first fits a `u64`.
+const ATAN_SERIES_BAM_Q7: [u64; 3] = [87_496_355_274, 29_165_451_758, 17_499_271_055];
+
 /// The angle of the vector (x, y) (any common scale); 0 for the zero vector.
 pub fn atan2(y: i64, x: i64) -> Angle {
     let (ax, ay) = (x.unsigned_abs(), y.unsigned_abs());
@@ -143,22 +197,23 @@ pub fn atan2(y: i64, x: i64) -> Angle {
     } else {
         (ax, ay, false)
     };
-    if big == 0 {
-        return Angle::ZERO;
-    }
     let excess = (u64::BITS - big.leading_zeros()).saturating_sub(ATAN_INPUT_BITS);
-    let (big, small) = ((big >> excess) as i64, (small >> excess) as i64);
-    // t = small / big in [0, 1], Q30.
-    let t = ratio(small << 30, big);
-    // Nearest sixteenth c = k/16, then atan(t) = atan(c) + atan((t - c) / (1 + t c)), |u| <= 1/32.
-    let k = ((t + (1 << 25)) >> 26).clamp(0, 16);
-    let c = k << 26;
-    let u = ratio((t - c) << 30, ONE + mul(t, c));
-    let u2 = mul(u, u);
-    // atan(u) = u (1 - u^2/3 + u^4/5 - u^6/7): error < 1e-14 for |u| <= 1/32.
-    let poly = mul(u, ONE - mul(u2, ONE / 3 - mul(u2, ONE / 5 - u2 / 7)));
-    let base = ATAN_SIXTEENTHS.get(k as usize).copied().unwrap_or(0);
-    let mut a = base + ((poly * BAM_PER_RAD_Q8 + (1 << 37)) >> 38);
+    let Some(big_kept) = NonZeroU64::new(big >> excess) else {
+        return Angle::ZERO;
+    };
+    let small = small >> excess;
+    // The sixty-fourth c = k/64 at or below small / big, then atan(small / big) = atan(c) + atan(u)
+    // with u = (small - c big) / (big + c small) in [0, 1/64), Q32 (small - c big < big < 2^32).
+    let k = (small << 6) / big_kept;
+    let big = big_kept.get();
+    let u = (((small << 6) - k * big) << 32)
+        .checked_div((big << 6) + k * small)
+        .unwrap_or(0);
+    let u2 = (u * u) >> 32;
+    let [p1, p3, p5] = ATAN_SERIES_BAM_Q7;
+    let series = p1 - ((u2 * (p3 - ((u2 * p5) >> 32))) >> 32);
+    let base = ATAN_SIXTY_FOURTHS.get(k as usize).copied().unwrap_or(0);
+    let mut a = i64::from(base) + ((u * series + (1 << 38)) >> 39) as i64;
     if swapped {
         a = QUARTER_TURN - a;
     }
@@ -178,13 +233,57 @@ pub fn ratio(num: i64, den: i64) -> i64 {
     num.checked_div(den).unwrap_or(0)
 }
 
+/// Right shift that leaves the top eight bits of a normalised [`sqrt`] argument (in
+/// [2^61, 2^63)) as the index into [`SQRT_SEEDS`].
+const SQRT_SEED_SHIFT: u32 = 55;
+
+/// Starting values for [`sqrt`]: entry i is sqrt((i + 1/2) * 2^55), the root of the middle of
+/// the arguments with top bits i, in units of 2^16. Within an interval the root differs from it
+/// by under 2^-8 (relative). Entries below 64 are never used (normalised arguments are at least
+/// 2^61) and kept so that any byte indexes the table.
+const SQRT_SEEDS: [u16; 256] = sqrt_seeds();
+
+/// Computes [`SQRT_SEEDS`] (at compile time).
+#[allow(clippy::indexing_slicing)] // i < 256 = the array's length; evaluated by the compiler
+const fn sqrt_seeds() -> [u16; 256] {
+    let mut seeds = [0u16; 256];
+    let mut i = 0;
+    while i < 256 {
+        let middle = (2 * i as u64 + 1) << (SQRT_SEED_SHIFT - 1);
+        seeds[i] = (middle.isqrt() >> 16) as u16;
+        i += 1;
+    }
+    seeds
+}
+
 /// Square root of a non-negative value, rounded down; 0 for negative input.
+///
+/// The argument is scaled by a power of 4 into m in [2^61, 2^63) (so sqrt(m) < 2^31.5 and r * r
+/// below fits a `u64`), a table gives sqrt(m) to a relative error d <= 2^-8, and two Newton
+/// steps r <- (r + m / r) / 2 follow. Rounded down, a Newton step never goes below floor(sqrt(m))
+/// and leaves a relative excess of at most d^2 / (2 (1 - d)): 2^-17 after the first, then at
+/// most 2^31.5 * 2^-34 / 2 < 0.1 absolute after the second, so r is floor(sqrt(m)) or one more.
+/// One comparison settles which, and floor(sqrt(n)) = floor(sqrt(m)) >> k for m = n * 4^k.
 pub fn sqrt(v: i64) -> i64 {
     if v <= 0 {
-        0
-    } else {
-        v.unsigned_abs().isqrt() as i64
+        return 0;
     }
+    let n = v.unsigned_abs();
+    // n < 2^63: at least one leading zero.
+    let half_shift = n.leading_zeros().saturating_sub(1) / 2;
+    let m = n << (2 * half_shift);
+    let seed = SQRT_SEEDS
+        .get(usize::from((m >> SQRT_SEED_SHIFT) as u8))
+        .copied()
+        .unwrap_or(0);
+    let mut r = u64::from(seed) << 16;
+    for _ in 0..2 {
+        r = (r + m.checked_div(r).unwrap_or(0)) >> 1;
+    }
+    if r * r > m {
+        r -= 1;
+    }
+    (r >> half_shift) as i64
 }
 
 #[cfg(test)]
@@ -226,6 +325,14 @@ mod tests {
     }
 
     #[test]
+    fn atan_table_matches_libm() {
+        for (k, &entry) in ATAN_SIXTY_FOURTHS.iter().enumerate() {
+            let want = libm::atan(k as f64 / 64.0) * 4_294_967_296.0 / core::f64::consts::TAU;
+            assert_eq!(i64::from(entry), libm::round(want) as i64, "atan({k}/64)");
+        }
+    }
+
+    #[test]
     fn atan2_of_axes_is_exact() {
         assert_eq!(atan2(0, 5), Angle(0));
         assert_eq!(atan2(5, 0), Angle(1 << 30));
@@ -254,5 +361,41 @@ mod tests {
         assert_eq!(sqrt(-4), 0);
         assert_eq!(sqrt(99), 9);
         assert_eq!(sqrt(1 << 60), 1 << 30);
+    }
+
+    #[test]
+    fn sqrt_matches_the_exact_root_at_every_scale() {
+        let check = |v: i64| {
+            assert_eq!(sqrt(v), v.unsigned_abs().isqrt() as i64, "sqrt({v})");
+        };
+        for v in 0..100_000 {
+            check(v);
+        }
+        // Around squares (the rounding boundaries) and the table's interval ends, every scale.
+        for bits in 0..32 {
+            for step in 0..500i128 {
+                let root = (1i128 << bits) + step * ((1i128 << bits) / 500).max(1);
+                for v in [root * root - 1, root * root, root * root + 1] {
+                    check(i64::try_from(v).unwrap_or(i64::MAX));
+                }
+            }
+        }
+        for shift in 0..=SQRT_SEED_SHIFT {
+            for top in 1u64..256 {
+                let edge = ((top << SQRT_SEED_SHIFT) >> shift) as i64;
+                for v in [edge - 1, edge, edge + 1] {
+                    check(v.max(0));
+                }
+            }
+        }
+        check(i64::MAX);
+        // Pseudo-random values of every magnitude.
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            check((x >> (x % 64)) as i64 & i64::MAX);
+        }
     }
 }

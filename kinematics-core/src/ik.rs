@@ -119,17 +119,65 @@ const ILL_CONDITIONED: Angle = Angle::from_centideg(2_000);
 /// Each branch that exists, indexed shoulder * 4 + wrist * 2 + elbow.
 pub(crate) type Branches = [Option<Branch>; MAX_BRANCHES];
 
-/// Frame 4 seen from frame 1, given M = A1^-1 * T06: (t2 + t3 + t4, origin x, origin y).
-/// T14 = M * A56^-1, of which only the rotation's first column and the position are needed:
-/// R14 e_x = M.R * (row 0 of R56), p14 = M.p - M.R * R56^T * p56.
-fn frame4(links: &Links, m: &Transform, t5: Angle, t6: Angle) -> (Angle, Len, Len) {
-    let a56 = links.link(4, t5).then(&links.link(5, t6));
-    let r56 = &a56.rotation;
-    let [x14_x, x14_y, _] = m
-        .rotation
-        .apply(&[r56.at(0, 0), r56.at(0, 1), r56.at(0, 2)]);
-    let [bx, by, _] = m.rotation.apply(&r56.transpose().apply(&a56.position));
-    (atan2(x14_y, x14_x), m.position[0] - bx, m.position[1] - by)
+/// The flange seen from frame 1, M = A1^-1 * T06, as far as the solver needs it.
+///
+/// With A1 = Rz(t1) * Tz(d1) * Rx(90 deg), A1^-1 = Rx(-90 deg) * Tz(-d1) * Rz(-t1), so M's
+/// rotation rows are (c1 r0 + s1 r1, r2, s1 r0 - c1 r1) (r_i the target rotation's rows) and its
+/// origin is (c1 px + s1 py, pz - d1, s1 px - c1 py), of which the third is never used.
+struct FlangeInFrame1 {
+    /// M's rotation, Q30.
+    rotation: [[i64; 3]; 3],
+    /// x and y of M's origin.
+    origin: [Len; 2],
+}
+
+impl FlangeInFrame1 {
+    /// M for the target `target` and t1 = atan2(`s1`, `c1`), shoulder height `d1`.
+    fn new(target: &Transform, s1: i64, c1: i64, d1: Len) -> Self {
+        let [[r00, r01, r02], [r10, r11, r12], row2] = target.rotation.0;
+        let [px, py, pz] = target.position;
+        // (c1, s1) . (a, b) and (s1, -c1) . (a, b).
+        let along = |a: i64, b: i64| (a * c1 + b * s1) >> 30;
+        let across = |a: i64, b: i64| (a * s1 - b * c1) >> 30;
+        Self {
+            rotation: [
+                [along(r00, r10), along(r01, r11), along(r02, r12)],
+                row2,
+                [across(r00, r10), across(r01, r11), across(r02, r12)],
+            ],
+            origin: [along(px, py), pz - d1],
+        }
+    }
+
+    /// The rotation of frame 4 seen from frame 1, t2 + t3 + t4, at the wrist angles
+    /// (sin t5, cos t5) and (sin t6, cos t6) (Q30).
+    ///
+    /// T14 = M * A56^-1, with A5 = Rz(t5) * Tz(d5) * Rx(-90 deg) and A6 = Rz(t6) * Tz(d6). Its
+    /// x axis is M.R times row 0 of R56, (c5 c6, -c5 s6, -s5).
+    fn frame4_angle(&self, (s5, c5): (i64, i64), (s6, c6): (i64, i64)) -> Angle {
+        let [row0, row1, _] = &self.rotation;
+        let x_axis = [mul(c5, c6), -mul(c5, s6), -s5];
+        atan2(dot(row1, &x_axis), dot(row0, &x_axis))
+    }
+
+    /// The origin of frame 4 seen from frame 1 (x, y) at the wrist angle (sin t6, cos t6) (Q30),
+    /// for the wrist offsets `d5` and `d6`; it does not depend on t5.
+    ///
+    /// p14 = M.p - M.R * R56^T * p56, and R56^T * p56 = (-d5 s6, -d5 c6, d6) (see
+    /// [`FlangeInFrame1::frame4_angle`] for A5 and A6).
+    fn frame4_origin(&self, (s6, c6): (i64, i64), d5: Len, d6: Len) -> [Len; 2] {
+        let [row0, row1, _] = &self.rotation;
+        let wrist = [-mul(d5, s6), -mul(d5, c6), d6];
+        let [ox, oy] = self.origin;
+        [ox - dot(row0, &wrist), oy - dot(row1, &wrist)]
+    }
+}
+
+/// The dot product of a Q30 row and a vector, in the vector's unit.
+#[inline]
+fn dot(row: &[i64; 3], v: &[i64; 3]) -> i64 {
+    let ([a, b, c], [x, y, z]) = (*row, *v);
+    (a * x + b * y + c * z) >> 30
 }
 
 /// At the wrist singularity the frame-4 origin e = c + d5 (-sin t234, cos t234) moves on a
@@ -183,10 +231,9 @@ pub(crate) fn solve(
 ) -> Result<Branches, IkError> {
     let [seed_theta1, _, seed_theta3, _, _, seed_theta6] = *seed_theta;
     let near = |a: Angle, b: Angle| a.sub(b).0.unsigned_abs() < SEED_WINDOW.0.unsigned_abs();
-    let [_, _, _, d4, d5, d6] = links.d;
+    let [d1, _, _, d4, d5, d6] = links.d;
     let [_, a2, a3, _, _, _] = links.a;
-    let r = &target.rotation;
-    let z = r.column(2);
+    let z = target.rotation.column(2);
     let [px, py, pz] = target.position;
     let w = [px - mul(d6, z[0]), py - mul(d6, z[1]), pz - mul(d6, z[2])];
     if w.iter().any(|c| c.abs() > MAX_WRIST_COORD) {
@@ -217,7 +264,8 @@ pub(crate) fn solve(
 
     let (s_len, d_len) = (a2.abs() + a3.abs(), (a2.abs() - a3.abs()).abs());
     // |e|^2 the seed's elbow angle reaches.
-    let seed_l2 = a2 * a2 + a3 * a3 + 2 * a2 * mul(a3, seed_theta3.sin_cos().1);
+    let seed_sin_cos3 = seed_theta3.sin_cos();
+    let seed_l2 = a2 * a2 + a3 * a3 + 2 * a2 * mul(a3, seed_sin_cos3.1);
     let cos_sign = if (a2 < 0) == (a3 < 0) { 1 } else { -1 };
     let mut out: Branches = [None; MAX_BRANCHES];
     let mut degenerate = false;
@@ -230,22 +278,45 @@ pub(crate) fn solve(
         };
         let t1 = t1.add(Angle::QUARTER);
         let (s1, c1) = t1.sin_cos();
-        let c5 = mul(z[0], s1) - mul(z[1], c1);
-        let (x1, y1) = (mul(z[0], c1) + mul(z[1], s1), z[2]);
+        // The flange in frame 1: its z axis is (-s5 c234, -s5 s234, c5) and the last row of its
+        // rotation (s5 c6, -s5 s6, c5).
+        let m = FlangeInFrame1::new(target, s1, c1, d1);
+        let [[_, _, x1], [_, _, y1], [s5_cos6, minus_s5_sin6, c5]] = m.rotation;
         let s5 = sqrt(x1 * x1 + y1 * y1);
-        // The flange in frame 1: M = A1^-1 * T06.
-        let m = links.link(0, t1).inverse().then(target);
+        let free_t6 = s5 < WRIST_SINGULAR_SIN;
+        // Wrist 0 has sin t5 >= 0. Wrist 1 negates t5, which turns t6 by half a turn (unless t6
+        // is free), and with it t234 (so the x axis of frame 4 is the same).
+        let t5_up = atan2(s5, c5);
+        let t6_up = if free_t6 {
+            seed_theta6
+        } else {
+            atan2(-minus_s5_sin6, s5_cos6)
+        };
+        let (sin6, cos6) = t6_up.sin_cos();
+        let t234_up = m.frame4_angle((s5, c5), (sin6, cos6));
+        let origin_up = m.frame4_origin((sin6, cos6), d5, d6);
         for (wrist, sign5) in [1i64, -1].into_iter().enumerate() {
-            let t5 = atan2(sign5 * s5, c5);
-            let free_t6 = s5 < WRIST_SINGULAR_SIN;
-            let mut t6 = if free_t6 {
-                seed_theta6
+            // (sin t5, cos t5) up to the length of z (1 within the rotation's rounding).
+            let sin_cos5 = (sign5 * s5, c5);
+            let (t5, mut t6, mut t234, [mut ex, mut ey]) = if wrist == 0 {
+                (t5_up, t6_up, t234_up, origin_up)
+            } else if free_t6 {
+                let t234 = m.frame4_angle(sin_cos5, (sin6, cos6));
+                (t5_up.neg(), t6_up, t234, origin_up)
             } else {
-                let sin6 = mul(c1, r.at(1, 1)) - mul(s1, r.at(0, 1));
-                let cos6 = mul(s1, r.at(0, 0)) - mul(c1, r.at(1, 0));
-                atan2(sign5 * sin6, sign5 * cos6)
+                let origin = m.frame4_origin((-sin6, -cos6), d5, d6);
+                (
+                    t5_up.neg(),
+                    t6_up.add(Angle::HALF),
+                    t234_up.add(Angle::HALF),
+                    origin,
+                )
             };
-            let (mut t234, mut ex, mut ey) = frame4(links, &m, t5, t6);
+            let frame4 = |t6: Angle| {
+                let sin_cos6 = t6.sin_cos();
+                let [ex, ey] = m.frame4_origin(sin_cos6, d5, d6);
+                (m.frame4_angle(sin_cos5, sin_cos6), ex, ey)
+            };
             // Near the wrist singularity t6 moves the frame-4 origin on a d5 circle. If this t6
             // puts it out of the elbow's reach by more than the wire's rounding, treat t6 as
             // free: start from the seed's and turn to the nearest t6 that reaches. Inside the
@@ -263,7 +334,7 @@ pub(crate) fn solve(
                 if !free_t6 {
                     t6 = seed_theta6;
                     approximate_wrist = true;
-                    (t234, ex, ey) = frame4(links, &m, t5, t6);
+                    (t234, ex, ey) = frame4(t6);
                 }
                 let (lo, hi) = (d_len + SINGULAR_REACH_MARGIN, s_len - SINGULAR_REACH_MARGIN);
                 if !reachable(ex, ey)
@@ -271,7 +342,7 @@ pub(crate) fn solve(
                 {
                     // At t5 = 0, t234 + t6 is fixed; at t5 = 180 deg, t234 - t6 is.
                     t6 = if c5 >= 0 { t6.sub(turn) } else { t6.add(turn) };
-                    (t234, ex, ey) = frame4(links, &m, t5, t6);
+                    (t234, ex, ey) = frame4(t6);
                 }
             }
             let l2 = ex * ex + ey * ey;
@@ -293,18 +364,27 @@ pub(crate) fn solve(
             let sin3 = sqrt(s_len * s_len - l2) * sqrt(l2 - d_len * d_len);
             let cos3 = cos_sign * (l2 - a2 * a2 - a3 * a3);
             let toward_e = atan2(ey, ex);
-            // Next to the stretched elbow t3 is ill-conditioned too: keep the seed's t3 if it
-            // reaches within SEED_SLACK of |e| and lies on this branch's side.
-            for (elbow, sign3) in [1i64, -1].into_iter().enumerate() {
-                let mut t3 = atan2(sign3 * sin3, cos3);
-                if near(seed_theta3, t3)
-                    && (seed_theta3.0 >= 0) == (t3.0 >= 0)
+            // Elbow 0 has sin t3 >= 0; elbow 1 mirrors it, negating t3 and the angle of e seen
+            // from frame 2, (a2 + a3 c3, a3 s3): times 2 |a2 a3| / |a3| that is
+            // (2 |a2| a2 + sgn(a3) cos3, sgn(a3) sin3), so it needs no sine and cosine of t3.
+            let t3_up = atan2(sin3, cos3);
+            let e_in_frame2_up = atan2(a3.signum() * sin3, 2 * a2.abs() * a2 + a3.signum() * cos3);
+            for (elbow, nominal_t3, nominal_e_in_frame2) in [
+                (0, t3_up, e_in_frame2_up),
+                (1, t3_up.neg(), e_in_frame2_up.neg()),
+            ] {
+                // Next to the stretched elbow t3 is ill-conditioned too: keep the seed's t3 if
+                // it reaches within SEED_SLACK of |e| and lies on this branch's side.
+                let (t3, e_in_frame2) = if near(seed_theta3, nominal_t3)
+                    && (seed_theta3.0 >= 0) == (nominal_t3.0 >= 0)
                     && (seed_l2 - l2).abs() <= 2 * sqrt(l2) * SEED_SLACK
                 {
-                    t3 = seed_theta3;
-                }
-                let (s3, c3) = t3.sin_cos();
-                let t2 = toward_e.sub(atan2(mul(a3, s3), a2 + mul(a3, c3)));
+                    let (s3, c3) = seed_sin_cos3;
+                    (seed_theta3, atan2(mul(a3, s3), a2 + mul(a3, c3)))
+                } else {
+                    (nominal_t3, nominal_e_in_frame2)
+                };
+                let t2 = toward_e.sub(e_in_frame2);
                 let t4 = t234.sub(t2).sub(t3);
                 let ill_conditioned = [phi, t3, t5, t5.sub(Angle::HALF)]
                     .iter()

@@ -39,15 +39,18 @@
 //! * FK: worst 0.0005 mm and 0.000001 deg before rounding to the wire (0.085 mm / 0.011 deg
 //!   after, which is the wire's own rounding).
 //! * IK of the exact FK, answers rounded to 0.01 deg: 100 % within 0.1 mm / 0.05 deg (worst
-//!   0.050 mm, 0.022 deg), singular configurations included.
+//!   0.050 mm, 0.020 deg), singular configurations included.
 //! * IK of the FK rounded to the wire (what `get_coords` then `send_coords` does), seeded with
 //!   the configuration read: 100 % within 0.1 mm / 0.05 deg (worst 0.086 mm, the rounding
 //!   itself). Next to singularities the rounded pose can be unreachable or far in joint space;
 //!   a seed that is already at the target to within the wire's rounding is returned as is.
 //!
-//! Host cost (x86-64, release): FK about 0.5 us and 2 300 instructions, IK (all branches and the
-//! selection) about 2 us and 8 900 to 9 500 instructions per call:
-//! * `cargo bench -p kinematics-core` (criterion: FK, IK, a 27-step linear path);
+//! Host cost (x86-64, release): FK about 0.3 us and 2 150 instructions, IK (all branches and the
+//! selection) about 0.7 us and 4 700 (seeded far from the answer) to 5 100 (seeded next to it)
+//! instructions per call:
+//! * `cargo bench -p kinematics-core` (criterion: FK, IK, a 27-step linear path; the times above
+//!   are the fastest of repeated runs, what an idle core gives; a busy machine reads up to three
+//!   times more);
 //! * `kinematics-core/benches/callgrind.sh` (instructions per call, via valgrind's callgrind:
 //!   the difference between runs of `examples/ik_count.rs` with N and with 0 calls);
 //! * `kinematics-core/benches/riscv_check.sh` builds for `riscv32imc-unknown-none-elf` (no FPU)

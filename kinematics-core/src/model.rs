@@ -110,14 +110,8 @@ impl Kinematics {
         seed: &JointAngles,
     ) -> Result<JointAngles, IkError> {
         let branches = ik::solve(&self.links, &self.flange_of(target), &self.seed_theta(seed));
-        // The best fit first (exact, clamped, near-singular), then the nearest to the seed.
         let best = branches.and_then(|branches| {
-            branches
-                .iter()
-                .flatten()
-                .filter_map(|b| Some((self.in_limits_near(&b.theta, seed)?, b)))
-                .min_by_key(|((_, distance), b)| (b.fit, *distance))
-                .map(|((q, _), b)| (q, b.ill_conditioned))
+            self.best_branch(&branches, seed)
                 .ok_or(IkError::OutsideLimits)
         });
         // Next to a singularity the wire's rounding can move the solution far from the seed, or
@@ -197,24 +191,114 @@ impl Kinematics {
         flange
     }
 
+    /// Of the branches whose joints all fit the limits, the best fit (exact, clamped,
+    /// near-singular), then the nearest `seed` (squared distance in joint space), the first of
+    /// equals: its protocol angles and whether it is ill-conditioned.
+    fn best_branch(
+        &self,
+        branches: &ik::Branches,
+        seed: &JointAngles,
+    ) -> Option<(JointAngles, bool)> {
+        let placements = self.placements(seed);
+        let mut best: Option<(ik::Fit, i64, JointAngles, bool)> = None;
+        for branch in branches.iter().flatten() {
+            if best.as_ref().is_some_and(|(fit, ..)| branch.fit > *fit) {
+                continue;
+            }
+            let Some((q, distance)) = self.place_all(&placements, &branch.theta) else {
+                continue;
+            };
+            if best
+                .as_ref()
+                .is_none_or(|(fit, least, ..)| (branch.fit, distance) < (*fit, *least))
+            {
+                best = Some((branch.fit, distance, q, branch.ill_conditioned));
+            }
+        }
+        best.map(|(_, _, q, ill_conditioned)| (q, ill_conditioned))
+    }
+
     /// DH angles `theta` as protocol angles wrapped into the limits nearest `seed`, with the
     /// squared distance to the seed; `None` if some joint cannot fit.
     fn in_limits_near(&self, theta: &[Angle; 6], seed: &JointAngles) -> Option<(JointAngles, i64)> {
+        self.place_all(&self.placements(seed), theta)
+    }
+
+    /// Each joint's [`Placement`] for the seed `seed`.
+    fn placements(&self, seed: &JointAngles) -> [Placement; 6] {
+        core::array::from_fn(|joint| {
+            let (min, max) = (
+                self.limits.min.get(joint).copied().unwrap_or(0),
+                self.limits.max.get(joint).copied().unwrap_or(0),
+            );
+            let seed = seed.0.get(joint).copied().unwrap_or(0);
+            // wrap_into moves q by the turns that bring it nearest the seed clamped into the
+            // limits; none when that seed - q is in [-180, 180) deg.
+            let seed_in_limits = seed.clamp(min, max.max(min));
+            Placement {
+                offset: self.links.offset.get(joint).copied().unwrap_or(Angle::ZERO),
+                seed,
+                kept_from: min.max(seed_in_limits.saturating_sub(HALF_TURN_CENTIDEG - 1)),
+                kept_to: max.min(seed_in_limits.saturating_add(HALF_TURN_CENTIDEG)),
+            }
+        })
+    }
+
+    /// [`Kinematics::place`] for every joint, with the sum of the squared distances; `None` if
+    /// some joint cannot fit.
+    fn place_all(
+        &self,
+        placements: &[Placement; 6],
+        theta: &[Angle; 6],
+    ) -> Option<(JointAngles, i64)> {
         let mut q = [0i32; 6];
         let mut distance = 0i64;
-        for (i, ((slot, &t), &s)) in q
+        for (joint, ((slot, placement), &t)) in q
             .iter_mut()
+            .zip(placements.iter())
             .zip(theta.iter())
-            .zip(seed.0.iter())
             .enumerate()
         {
-            let offset = self.links.offset.get(i).copied().unwrap_or(Angle::ZERO);
-            *slot = self.limits.wrap_into(i, t.sub(offset).to_centideg(), s)?;
-            let d = i64::from(*slot) - i64::from(s);
-            distance = distance.saturating_add(d.saturating_mul(d));
+            let (angle, squared) = self.place(joint, placement, t)?;
+            *slot = angle;
+            distance = distance.saturating_add(squared);
         }
         Some((JointAngles(q), distance))
     }
+
+    /// Joint `joint`'s DH angle `theta` as the protocol angle wrapped by +-360 deg into the
+    /// limits nearest the seed ([`JointLimits::wrap_into`]), with its squared distance from the
+    /// seed; `None` if no turn of it fits.
+    fn place(&self, joint: usize, placement: &Placement, theta: Angle) -> Option<(i32, i64)> {
+        let q = theta.sub(placement.offset).to_centideg();
+        // What wrap_into gives when q itself is the turn nearest the seed and fits, without its
+        // division; any other case goes to wrap_into.
+        let angle = if (placement.kept_from..=placement.kept_to).contains(&q) {
+            q
+        } else {
+            self.limits.wrap_into(joint, q, placement.seed)?
+        };
+        let d = i64::from(angle) - i64::from(placement.seed);
+        Some((angle, d.saturating_mul(d)))
+    }
+}
+
+/// Half a turn in centidegrees.
+const HALF_TURN_CENTIDEG: i32 = 18_000;
+
+/// What choosing a joint's angle needs, computed once per solve: its DH offset, the seed's
+/// angle, and the protocol angles that [`JointLimits::wrap_into`] keeps as they are (within the
+/// limits and less than half a turn from the seed clamped into them).
+#[derive(Clone, Copy, Debug)]
+struct Placement {
+    /// DH angle at protocol angle 0.
+    offset: Angle,
+    /// The seed's angle, centidegrees.
+    seed: i32,
+    /// Lowest angle kept as it is, centidegrees.
+    kept_from: i32,
+    /// Highest angle kept as it is, centidegrees.
+    kept_to: i32,
 }
 
 /// A transform paired with its inverse.

@@ -255,7 +255,8 @@ impl<P: Path> PathWalker<P> {
         if self.stopped || self.done_um >= length {
             return None;
         }
-        let mut size = advance_um.clamp(1, length - self.done_um);
+        // max/min rather than clamp, which asserts its bounds (a panic path); here 1 <= the rest.
+        let mut size = advance_um.max(1).min(length - self.done_um);
         let mut splits = 0;
         let result = loop {
             let at = self.done_um + size;

@@ -79,7 +79,8 @@ impl Part {
 
     /// The circle angle and orientation `at_um` into this part (0..=length).
     fn at(&self, at_um: i64) -> (i64, Rotation) {
-        let at = at_um.clamp(0, self.length_um);
+        // max/min rather than clamp, which asserts its bounds (a panic path).
+        let at = at_um.max(0).min(self.length_um);
         let t = self.from + ratio(self.sweep * at, self.length_um);
         let turn = Angle(ratio(i64::from(self.angle.0) * at, self.length_um) as i32);
         (
