@@ -50,7 +50,7 @@ impl Default for ArmGeometry {
 
 /// DH alpha of each joint, centidegrees: the structure the closed-form IK relies on (the same
 /// for every [`ArmGeometry`]). Published for models drawn outside this crate (the virtual
-/// robot's 3D view); [`ALPHA_SIN_COS`] is the form the chain computes with.
+/// robot's 3D view); `ALPHA_SIN_COS` is the form the chain computes with.
 pub const DH_ALPHA_CENTIDEG: [i32; 6] = [9000, 0, 0, 9000, -9000, 0];
 
 /// [`DH_ALPHA_CENTIDEG`] as (sin, cos) in Q30.
