@@ -19,7 +19,7 @@ use protocol_core::units::{Centideg, Steps};
 use protocol_core::{BytePort, Frame};
 
 use crate::collision::{Collision, CollisionSettings};
-use crate::config::{AtomConfig, ConfigError, JOINTS, JointLimit};
+use crate::config::{AtomConfig, ConfigError, JOINTS, JointLimit, SERVOS};
 use crate::context::Context;
 use crate::driver::{Op, Outcome};
 use crate::flash_writes::QUIET_US;
@@ -110,13 +110,16 @@ impl Atom {
     }
 
     /// Writes one record waiting for the flash ([`crate::flash_writes`]) if the arm is quiet:
-    /// no request heard for [`QUIET_US`], nothing moving or being recorded, no servo
-    /// transaction, reply or read under way. The flash stops the chip meanwhile.
+    /// no request heard for [`QUIET_US`], no motion under way, no servo known to move, no
+    /// drag teaching being recorded, no servo transaction, reply or read under way. The flash
+    /// stops the chip meanwhile. A servo that does not answer, or an arm released and off its
+    /// goals, does not keep the records from the flash.
     fn write_flash_when_quiet<I: AtomIo>(&mut self, now_us: u64, io: &mut I) {
         let p = &self.parts;
         let quiet = !p.flash_writes.is_empty()
             && now_us.saturating_sub(self.last_request_us) >= QUIET_US
-            && !p.is_moving(now_us)
+            && !p.motion.is_active()
+            && (0..SERVOS).all(|i| !p.bank.servo_moving(now_us, i))
             && !p.drag.is_recording()
             && p.waiting.is_empty()
             && self.schedule.is_idle();

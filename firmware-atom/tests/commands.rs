@@ -886,3 +886,19 @@ fn a_restore_that_moves_a_zero_releases_the_servo_instead_of_letting_it_jump() {
         "reads 30 degrees again: {angle}"
     );
 }
+
+#[test]
+fn settings_reach_the_flash_with_a_silent_servo_and_an_arm_off_its_goals() {
+    let mut rig = Rig::new();
+    rig.bus.servo(4).set_faults(Faults::NO_ANSWER);
+    // Switched off and turned by hand: no joint is on the goal it last held.
+    assert_eq!(rig.ask(0x11, &[]), [1]);
+    rig.bus.servo(2).move_by_hand(2400);
+    rig.run_ms(50);
+    assert_eq!(rig.ask(0x75, &[3, 180]), [1]);
+    // Quiet for more than 20 ms: the threshold is written, and survives a restart.
+    rig.run_ms(100);
+    rig.atom = firmware_atom::Atom::new(firmware_atom::AtomConfig::default());
+    rig.run_ms(50);
+    assert_eq!(rig.ask(0x76, &[]), [100, 100, 180, 100, 100, 100]);
+}
