@@ -30,7 +30,7 @@ use super::contact::Obstacle;
 use super::reply_faults::ReplyFault;
 use super::robot::SERVO_IDS;
 use super::servo::SimServo;
-use super::wire::{Bus, HeardByte, StationId};
+use super::wire::{Bus, BusByte, HeardByte, StationId};
 use firmware_atom::AtomConfig;
 use sim_hw::ServoChain;
 
@@ -204,6 +204,24 @@ impl EmulatedArm {
     /// servo.
     pub fn add_reply_fault(&mut self, fault: ReplyFault) -> bool {
         fault.apply(&mut self.servos)
+    }
+
+    /// Records every byte that completes on the wire from now on (`true`), for
+    /// [`EmulatedArm::take_trace`]; off by default.
+    pub fn set_tracing(&mut self, on: bool) {
+        self.bus.set_tracing(on);
+    }
+
+    /// Bytes that completed on the wire since the last call, in end order (empty unless
+    /// tracing is on).
+    pub fn take_trace(&mut self) -> Vec<BusByte> {
+        self.bus.take_trace()
+    }
+
+    /// The bus station of `board` (the servos are stations 0 to 6, the boards follow in the
+    /// order they were attached).
+    pub fn station(&self, board: BoardId) -> Option<StationId> {
+        self.boards.get(board.0).map(|b| b.station)
     }
 
     /// Virtual time, in microseconds.
