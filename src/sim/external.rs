@@ -63,15 +63,22 @@ impl FrameGate {
         }
     }
 
-    /// Appends to `out` what may go on the wire at `now_ns`: every whole frame, the bytes before
-    /// a frame's start that belong to none, and everything once it is stale.
+    /// Appends to `out` what may go on the wire at `now_ns`: the first whole frame, the bytes
+    /// around it that belong to none, and everything once it is stale. A frame behind it waits
+    /// for the next call (the line must be free for it again: see [`EmulatedArm`]).
     pub fn release(&mut self, now_ns: u64, out: &mut Vec<u8>) {
         let stale = now_ns.saturating_sub(self.last_byte_ns) >= STALE_AFTER_NS;
         let mut ready = 0;
+        let mut whole = false;
         loop {
             let rest = self.held.get(ready..).unwrap_or_default();
             match frame_extent(rest) {
-                Extent::Whole(n) | Extent::NotAFrame(n) => ready += n,
+                Extent::Whole(_) if whole && !stale => break,
+                Extent::Whole(n) => {
+                    ready += n;
+                    whole = true;
+                }
+                Extent::NotAFrame(n) => ready += n,
                 Extent::Partial if stale || rest.len() > GATE_BYTES => ready = self.held.len(),
                 Extent::Partial | Extent::Empty => break,
             }
@@ -296,9 +303,15 @@ impl EmulatedArm {
             self.servos.hear(&heard);
         }
         self.servos.transmit_due(now_ns, &mut self.bus);
+        // A servo's answer due: no board starts in the turnaround before it. On the wire the
+        // Atom sends its next packet only after the answer (or its deadline), but a board
+        // whose emulator or socket was held up hands over several packets at once, and sent
+        // back to back each would run into the answer to the one before.
+        let answer_due = self.servos.next_event_ns().is_some();
         for board in &mut self.boards {
             let quiet_ns = now_ns.saturating_sub(self.bus.last_activity_ns());
-            let line_free = !self.bus.busy() && quiet_ns >= board.quiet_before_send_ns;
+            let line_free =
+                !self.bus.busy() && !answer_due && quiet_ns >= board.quiet_before_send_ns;
             let Some(mut port) = self.bus.port(board.station) else {
                 continue;
             };
@@ -441,5 +454,25 @@ mod tests {
         arm.run_until(8_000);
         arm.board_received(basic, &mut heard);
         assert_eq!(heard, reply);
+    }
+
+    #[test]
+    fn packets_that_arrive_together_wait_for_each_others_answers() {
+        let mut arm = EmulatedArm::new(1, 2048);
+        arm.set_tracing(true);
+        let atom = arm.attach_board(0);
+        arm.run_until(100);
+        // Two READs of the present position (servos 1 and 2) in one chunk: the emulated Atom
+        // timed the first out while its bytes waited in the socket.
+        let read_1 = [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE];
+        let read_2 = [0xFF, 0xFF, 0x02, 0x04, 0x02, 0x38, 0x02, 0xBD];
+        arm.board_sent(atom, 100, &[read_1, read_2].concat());
+        arm.run_until(5_000);
+        let mut heard = Vec::new();
+        arm.board_received(atom, &mut heard);
+        let answer_1 = [0xFF, 0xFF, 0x01, 0x04, 0x00, 0x00, 0x08, 0xF2];
+        let answer_2 = [0xFF, 0xFF, 0x02, 0x04, 0x00, 0x00, 0x08, 0xF1];
+        assert_eq!(heard, [answer_1, answer_2].concat(), "{heard:02X?}");
+        assert!(arm.take_trace().iter().all(|b| !b.garbled));
     }
 }
