@@ -73,12 +73,15 @@ impl FrameGate {
         loop {
             let rest = self.held.get(ready..).unwrap_or_default();
             match frame_extent(rest) {
-                Extent::Whole(_) if whole && !stale => break,
+                // Whole frames go one at a time however long they waited (staleness is for
+                // a frame cut short, not for one held behind another).
+                Extent::Whole(_) if whole => break,
                 Extent::Whole(n) => {
                     ready += n;
                     whole = true;
                 }
                 Extent::NotAFrame(n) => ready += n,
+                Extent::Partial if whole => break,
                 Extent::Partial if stale || rest.len() > GATE_BYTES => ready = self.held.len(),
                 Extent::Partial | Extent::Empty => break,
             }
@@ -474,5 +477,16 @@ mod tests {
         let answer_2 = [0xFF, 0xFF, 0x02, 0x04, 0x00, 0x00, 0x08, 0xF1];
         assert_eq!(heard, [answer_1, answer_2].concat(), "{heard:02X?}");
         assert!(arm.take_trace().iter().all(|b| !b.garbled));
+    }
+
+    #[test]
+    fn whole_frames_held_past_the_stale_time_still_go_one_at_a_time() {
+        let mut gate = FrameGate::new();
+        let read_1 = [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE];
+        let read_2 = [0xFF, 0xFF, 0x02, 0x04, 0x02, 0x38, 0x02, 0xBD];
+        gate.push(0, &[read_1, read_2].concat());
+        assert_eq!(released(&mut gate, 10 * STALE_AFTER_NS), read_1);
+        assert_eq!(released(&mut gate, 10 * STALE_AFTER_NS), read_2);
+        assert!(!gate.holds());
     }
 }
