@@ -26,7 +26,7 @@ use crate::flash_writes::QUIET_US;
 use crate::io::AtomIo;
 use crate::link::{Link, READ_BUDGET, UsbLink};
 use crate::parts::Parts;
-use crate::schedule::{BusEvent, BusSchedule};
+use crate::schedule::{BusEvent, BusEvents, BusSchedule};
 use crate::settings::Settings;
 use crate::store::ParamStore;
 
@@ -82,13 +82,17 @@ impl Atom {
             self.stored_settings_loaded = true;
             self.load_stored_settings(io);
         }
+        // One buffer for the whole pass, filled and emptied in place (`BusSchedule::hear`).
+        let mut events = BusEvents::new();
         for _ in 0..READ_BUDGET {
             let Some(byte) = bus.read_byte() else { break };
-            for event in self.schedule.hear(now_us, byte) {
+            self.schedule.hear(now_us, byte, &mut events);
+            for event in events.drain(..) {
                 self.on_bus_event(now_us, event, usb, io);
             }
         }
-        for event in self.schedule.on_time(now_us) {
+        self.schedule.on_time(now_us, &mut events);
+        for event in events.drain(..) {
             self.on_bus_event(now_us, event, usb, io);
         }
         self.receive_usb(now_us, usb, io);

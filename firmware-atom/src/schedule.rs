@@ -103,19 +103,23 @@ impl BusSchedule {
         }
     }
 
-    /// Takes one byte heard on the bus at `now_us`; returns the frames and packets it
-    /// completes (our own reply's echo left out).
-    pub fn hear(&mut self, now_us: u64, byte: u8) -> BusEvents {
-        let mut events = BusEvents::new();
-        self.rx.push(now_us, byte, &mut collect(&mut events));
-        self.drop_own_reply(now_us, events)
+    /// Takes one byte heard on the bus at `now_us`; appends to `events` the frames and packets
+    /// it completes (our own reply's echo left out).
+    ///
+    /// `events` is the caller's, emptied by it after each call: [`BusEvents`] holds up to
+    /// `MAX_FRAMES_AT_ONCE + 1` whole frames and packets (about 1.5 KiB), and returning a fresh
+    /// one per byte cost two copies of it for every byte heard, most of the loop's time at
+    /// 1 Mbaud (docs/boards.md, "Emulated boards").
+    pub fn hear(&mut self, now_us: u64, byte: u8, events: &mut BusEvents) {
+        self.rx.push(now_us, byte, &mut collect(events));
+        self.drop_own_reply(now_us, events);
     }
 
-    /// Handles the passage of time: frames and packets cut short by a quiet line, and a reply
-    /// that collided (queued again). Call once per poll after the received bytes.
-    pub fn on_time(&mut self, now_us: u64) -> BusEvents {
-        let mut events = BusEvents::new();
-        self.rx.on_time(now_us, &mut collect(&mut events));
+    /// Handles the passage of time: frames and packets cut short by a quiet line (appended to
+    /// `events`, as in [`BusSchedule::hear`]), and a reply that collided (queued again). Call
+    /// once per poll after the received bytes.
+    pub fn on_time(&mut self, now_us: u64, events: &mut BusEvents) {
+        self.rx.on_time(now_us, &mut collect(events));
         if self.rx.take_collision()
             && self.reply_on_wire
             && self.reply_resends > 0
@@ -125,18 +129,20 @@ impl BusSchedule {
             self.reply_resends -= 1;
             self.resend = Some(reply.clone());
         }
-        self.drop_own_reply(now_us, events)
+        self.drop_own_reply(now_us, events);
     }
 
     /// Leaves out a frame equal to our last reply within its echo window (some replies, e.g.
     /// angles to coords, have the layout of a valid request).
-    fn drop_own_reply(&self, now_us: u64, mut events: BusEvents) -> BusEvents {
+    fn drop_own_reply(&self, now_us: u64, events: &mut BusEvents) {
+        if events.is_empty() {
+            return;
+        }
         if let Some((last, until_us)) = &self.last_reply
             && now_us <= *until_us
         {
             events.retain(|e| !matches!(e, BusEvent::Frame(f) if f == last));
         }
-        events
     }
 
     /// Queues `reply` for the host; a newer reply replaces an unsent one (the host has given
@@ -327,5 +333,32 @@ mod tests {
             "a servo instruction, no gap"
         );
         assert!(schedule.driver.busy());
+    }
+
+    /// What the Atom hears goes into the caller's buffer, in order, and the echo of its own
+    /// last reply is left out of it there (no buffer is returned per byte: docs/boards.md).
+    #[test]
+    fn heard_frames_fill_the_callers_buffer_without_our_own_echo() {
+        let (settings, mut bank) = at_rest();
+        let mut schedule = BusSchedule::new(settings.config().timing.reply_margin_us);
+        let mut wire = Wire::default();
+        let reply = Frame::new(0x20, &[1]).unwrap();
+        schedule.send_reply(reply.clone());
+        schedule.start_next(10_000, &mut wire, &mut bank, &settings);
+        let mut events = BusEvents::new();
+        for (i, &byte) in reply.to_bytes().iter().enumerate() {
+            schedule.hear(10_010 + i as u64 * 10, byte, &mut events);
+        }
+        schedule.on_time(10_300, &mut events);
+        assert!(events.is_empty(), "our own echo: {events:?}");
+        let request = Frame::new(0x20, &[]).unwrap();
+        let mut heard = std::vec::Vec::new();
+        for (i, &byte) in request.to_bytes().iter().enumerate() {
+            schedule.hear(20_000 + i as u64 * 10, byte, &mut events);
+            heard.extend(events.drain(..));
+        }
+        schedule.on_time(30_000, &mut events);
+        heard.extend(events.drain(..));
+        assert_eq!(heard, [BusEvent::Frame(request)]);
     }
 }

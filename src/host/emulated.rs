@@ -17,6 +17,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use crate::sim::external::{BoardId, EmulatedArm};
+use crate::sim::{BusByte, StationId};
 
 use super::realtime::RealtimeRobot;
 
@@ -109,6 +110,102 @@ impl Chardev {
     }
 }
 
+/// The environment variable that names a file for [`BusTrace`]'s lines.
+pub const BUS_TRACE_ENV: &str = "OPEN_MYCOBOT_BUS_TRACE";
+
+/// A record of the emulated boards' traffic, for finding where time goes (docs/boards.md,
+/// "Emulated boards"): every chunk read from or written to a board's socket, stamped with the
+/// wall clock and virtual time, and every frame on the simulated wire with its sender and its
+/// start and end in virtual time. Off unless [`BUS_TRACE_ENV`] names a file.
+///
+/// Lines: `W<wall us> V<virtual us> <socket> <in|out> <hex>` for a socket's chunk,
+/// `V<start us>-<end us> wire <station> <hex>` for a frame (bytes of one sender less than
+/// 100 us apart), with ` GARBLED` when a byte of it collided.
+#[derive(Debug)]
+struct BusTrace {
+    out: std::io::BufWriter<std::fs::File>,
+    started: Instant,
+    /// The frame on the wire being gathered: sender, start, end of its last byte, bytes.
+    frame: Option<(StationId, u64, u64, Vec<u8>, bool)>,
+}
+
+impl BusTrace {
+    fn from_env() -> Option<Self> {
+        let path = std::env::var_os(BUS_TRACE_ENV)?;
+        match std::fs::File::create(&path) {
+            Ok(file) => Some(Self {
+                out: std::io::BufWriter::new(file),
+                started: Instant::now(),
+                frame: None,
+            }),
+            Err(e) => {
+                eprintln!(
+                    "open-mycobot: no bus trace ({}: {e})",
+                    path.to_string_lossy()
+                );
+                None
+            }
+        }
+    }
+
+    fn chunk(&mut self, virtual_us: u64, socket: &str, dir: &str, bytes: &[u8]) {
+        if !bytes.is_empty() {
+            let wall = self.started.elapsed().as_micros();
+            let _ = writeln!(
+                self.out,
+                "W{wall} V{virtual_us} {socket} {dir} {}",
+                hex(bytes)
+            );
+        }
+    }
+
+    fn wire(&mut self, bytes: &[BusByte], names: &dyn Fn(StationId) -> String) {
+        for b in bytes {
+            match &mut self.frame {
+                Some((from, _, end, frame, garbled))
+                    if *from == b.from && b.start_ns.saturating_sub(*end) < 100_000 =>
+                {
+                    *end = b.end_ns;
+                    frame.push(b.byte);
+                    *garbled |= b.garbled;
+                }
+                _ => {
+                    self.flush_frame(names);
+                    self.frame = Some((b.from, b.start_ns, b.end_ns, vec![b.byte], b.garbled));
+                }
+            }
+        }
+    }
+
+    fn flush_frame(&mut self, names: &dyn Fn(StationId) -> String) {
+        if let Some((from, start, end, frame, garbled)) = self.frame.take() {
+            let _ = writeln!(
+                self.out,
+                "V{}-{} wire {} {}{}",
+                start / 1_000,
+                end / 1_000,
+                names(from),
+                hex(&frame),
+                if garbled { " GARBLED" } else { "" }
+            );
+        }
+    }
+}
+
+impl Drop for BusTrace {
+    fn drop(&mut self) {
+        let _ = self.out.flush();
+    }
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes
+        .iter()
+        .map(|b| format!("{b:02X}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// The simulated bus and servos with emulated boards on it, served in real time. See the
 /// [module doc](self).
 #[derive(Debug)]
@@ -117,6 +214,7 @@ pub struct EmulatedBoards {
     buses: Vec<(BoardId, Chardev)>,
     front: Chardev,
     scratch: Vec<u8>,
+    trace: Option<BusTrace>,
 }
 
 impl EmulatedBoards {
@@ -127,12 +225,35 @@ impl EmulatedBoards {
             .into_iter()
             .map(|(chardev, quiet_us)| (arm.attach_board(quiet_us), chardev))
             .collect();
+        let trace = BusTrace::from_env();
+        arm.set_tracing(trace.is_some());
         Self {
             arm,
             buses,
             front,
             scratch: Vec::new(),
+            trace,
         }
+    }
+
+    /// Writes what went on the wire since the last call to the trace, if there is one.
+    fn trace_wire(&mut self) {
+        let Some(trace) = &mut self.trace else {
+            return;
+        };
+        let bytes = self.arm.take_trace();
+        let boards: Vec<(StationId, &str)> = self
+            .buses
+            .iter()
+            .filter_map(|(board, chardev)| Some((self.arm.station(*board)?, chardev.name)))
+            .collect();
+        let names = |station: StationId| {
+            boards.iter().find(|(s, _)| *s == station).map_or_else(
+                || format!("servo-station-{}", station.index()),
+                |(_, name)| name.replace(' ', "-"),
+            )
+        };
+        trace.wire(&bytes, &names);
     }
 }
 
@@ -142,23 +263,38 @@ impl RealtimeRobot for EmulatedBoards {
     }
 
     fn host_write(&mut self, bytes: &[u8]) {
+        if let Some(trace) = &mut self.trace {
+            trace.chunk(self.arm.now_us(), self.front.name, "out", bytes);
+        }
         self.front.send(bytes);
     }
 
     fn host_read(&mut self, out: &mut Vec<u8>) {
+        let from = out.len();
         self.front.read_into(out);
+        if let Some(trace) = &mut self.trace {
+            let bytes = out.get(from..).unwrap_or_default();
+            trace.chunk(self.arm.now_us(), self.front.name, "in", bytes);
+        }
     }
 
     fn run_until(&mut self, t_us: u64) {
         for (board, chardev) in &mut self.buses {
             self.scratch.clear();
             chardev.read_into(&mut self.scratch);
+            if let Some(trace) = &mut self.trace {
+                trace.chunk(t_us, chardev.name, "in", &self.scratch);
+            }
             self.arm.board_sent(*board, t_us, &self.scratch);
         }
         self.arm.run_until(t_us);
+        self.trace_wire();
         for (board, chardev) in &mut self.buses {
             self.scratch.clear();
             self.arm.board_received(*board, &mut self.scratch);
+            if let Some(trace) = &mut self.trace {
+                trace.chunk(t_us, chardev.name, "out", &self.scratch);
+            }
             chardev.send(&self.scratch);
         }
     }

@@ -30,7 +30,7 @@ use super::contact::Obstacle;
 use super::reply_faults::ReplyFault;
 use super::robot::SERVO_IDS;
 use super::servo::SimServo;
-use super::wire::{Bus, HeardByte, StationId};
+use super::wire::{Bus, BusByte, HeardByte, StationId};
 use firmware_atom::AtomConfig;
 use sim_hw::ServoChain;
 
@@ -63,15 +63,25 @@ impl FrameGate {
         }
     }
 
-    /// Appends to `out` what may go on the wire at `now_ns`: every whole frame, the bytes before
-    /// a frame's start that belong to none, and everything once it is stale.
+    /// Appends to `out` what may go on the wire at `now_ns`: the first whole frame, the bytes
+    /// around it that belong to none, and everything once it is stale. A frame behind it waits
+    /// for the next call (the line must be free for it again: see [`EmulatedArm`]).
     pub fn release(&mut self, now_ns: u64, out: &mut Vec<u8>) {
         let stale = now_ns.saturating_sub(self.last_byte_ns) >= STALE_AFTER_NS;
         let mut ready = 0;
+        let mut whole = false;
         loop {
             let rest = self.held.get(ready..).unwrap_or_default();
             match frame_extent(rest) {
-                Extent::Whole(n) | Extent::NotAFrame(n) => ready += n,
+                // Whole frames go one at a time however long they waited (staleness is for
+                // a frame cut short, not for one held behind another).
+                Extent::Whole(_) if whole => break,
+                Extent::Whole(n) => {
+                    ready += n;
+                    whole = true;
+                }
+                Extent::NotAFrame(n) => ready += n,
+                Extent::Partial if whole => break,
                 Extent::Partial if stale || rest.len() > GATE_BYTES => ready = self.held.len(),
                 Extent::Partial | Extent::Empty => break,
             }
@@ -206,6 +216,24 @@ impl EmulatedArm {
         fault.apply(&mut self.servos)
     }
 
+    /// Records every byte that completes on the wire from now on (`true`), for
+    /// [`EmulatedArm::take_trace`]; off by default.
+    pub fn set_tracing(&mut self, on: bool) {
+        self.bus.set_tracing(on);
+    }
+
+    /// Bytes that completed on the wire since the last call, in end order (empty unless
+    /// tracing is on).
+    pub fn take_trace(&mut self) -> Vec<BusByte> {
+        self.bus.take_trace()
+    }
+
+    /// The bus station of `board` (the servos are stations 0 to 6, the boards follow in the
+    /// order they were attached).
+    pub fn station(&self, board: BoardId) -> Option<StationId> {
+        self.boards.get(board.0).map(|b| b.station)
+    }
+
     /// Virtual time, in microseconds.
     pub fn now_us(&self) -> u64 {
         self.now_ns / 1_000
@@ -278,9 +306,15 @@ impl EmulatedArm {
             self.servos.hear(&heard);
         }
         self.servos.transmit_due(now_ns, &mut self.bus);
+        // A servo's answer due: no board starts in the turnaround before it. On the wire the
+        // Atom sends its next packet only after the answer (or its deadline), but a board
+        // whose emulator or socket was held up hands over several packets at once, and sent
+        // back to back each would run into the answer to the one before.
+        let answer_due = self.servos.next_event_ns().is_some();
         for board in &mut self.boards {
             let quiet_ns = now_ns.saturating_sub(self.bus.last_activity_ns());
-            let line_free = !self.bus.busy() && quiet_ns >= board.quiet_before_send_ns;
+            let line_free =
+                !self.bus.busy() && !answer_due && quiet_ns >= board.quiet_before_send_ns;
             let Some(mut port) = self.bus.port(board.station) else {
                 continue;
             };
@@ -423,5 +457,36 @@ mod tests {
         arm.run_until(8_000);
         arm.board_received(basic, &mut heard);
         assert_eq!(heard, reply);
+    }
+
+    #[test]
+    fn packets_that_arrive_together_wait_for_each_others_answers() {
+        let mut arm = EmulatedArm::new(1, 2048);
+        arm.set_tracing(true);
+        let atom = arm.attach_board(0);
+        arm.run_until(100);
+        // Two READs of the present position (servos 1 and 2) in one chunk: the emulated Atom
+        // timed the first out while its bytes waited in the socket.
+        let read_1 = [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE];
+        let read_2 = [0xFF, 0xFF, 0x02, 0x04, 0x02, 0x38, 0x02, 0xBD];
+        arm.board_sent(atom, 100, &[read_1, read_2].concat());
+        arm.run_until(5_000);
+        let mut heard = Vec::new();
+        arm.board_received(atom, &mut heard);
+        let answer_1 = [0xFF, 0xFF, 0x01, 0x04, 0x00, 0x00, 0x08, 0xF2];
+        let answer_2 = [0xFF, 0xFF, 0x02, 0x04, 0x00, 0x00, 0x08, 0xF1];
+        assert_eq!(heard, [answer_1, answer_2].concat(), "{heard:02X?}");
+        assert!(arm.take_trace().iter().all(|b| !b.garbled));
+    }
+
+    #[test]
+    fn whole_frames_held_past_the_stale_time_still_go_one_at_a_time() {
+        let mut gate = FrameGate::new();
+        let read_1 = [0xFF, 0xFF, 0x01, 0x04, 0x02, 0x38, 0x02, 0xBE];
+        let read_2 = [0xFF, 0xFF, 0x02, 0x04, 0x02, 0x38, 0x02, 0xBD];
+        gate.push(0, &[read_1, read_2].concat());
+        assert_eq!(released(&mut gate, 10 * STALE_AFTER_NS), read_1);
+        assert_eq!(released(&mut gate, 10 * STALE_AFTER_NS), read_2);
+        assert!(!gate.holds());
     }
 }
