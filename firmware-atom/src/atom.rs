@@ -128,7 +128,8 @@ impl Atom {
             && p.waiting.is_empty()
             && self.schedule.is_idle();
         if let (true, Some(flash)) = (quiet, io.param_store()) {
-            self.parts.flash_writes.write_one(flash);
+            // A failure leaves the change in force until a restart (flash_writes).
+            let _ = self.parts.flash_writes.write_one(flash);
         }
     }
 

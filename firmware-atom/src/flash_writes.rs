@@ -39,18 +39,12 @@ struct Record {
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct FlashWrites {
     waiting: Vec<Record, MAX_WAITING>,
-    failed: u32,
 }
 
 impl FlashWrites {
     /// True if every record is in flash.
     pub fn is_empty(&self) -> bool {
         self.waiting.is_empty()
-    }
-
-    /// Writes that failed so far (the record stayed in force until the next restart).
-    pub fn failed(&self) -> u32 {
-        self.failed
     }
 
     /// The flash seen through the records waiting: a read finds the newest record, a write
@@ -62,17 +56,15 @@ impl FlashWrites {
         })
     }
 
-    /// Writes the oldest waiting record to `flash`; true if there was one. A failed write
-    /// is counted ([`FlashWrites::failed`]) and not tried again.
-    pub fn write_one(&mut self, flash: &mut dyn ParamStore) -> bool {
+    /// Writes the oldest waiting record to `flash`: `None` if none waits, else how the write
+    /// went. A failed write is not tried again (a broken flash would stall every pass); the
+    /// change stays in force until the Atom restarts.
+    pub fn write_one(&mut self, flash: &mut dyn ParamStore) -> Option<Result<(), StoreError>> {
         if self.waiting.is_empty() {
-            return false;
+            return None;
         }
         let record = self.waiting.remove(0);
-        if flash.store(record.key, &record.bytes).is_err() {
-            self.failed = self.failed.saturating_add(1);
-        }
-        true
+        Some(flash.store(record.key, &record.bytes))
     }
 }
 
@@ -129,10 +121,10 @@ mod tests {
         queued.store(1, &[2, 2]).unwrap();
         assert_eq!(fetch(&mut queued, 1), Some(vec![2, 2]));
         assert_eq!(fetch(&mut flash, 1), Some(vec![1]), "not in flash yet");
-        assert!(writes.write_one(&mut flash));
+        assert_eq!(writes.write_one(&mut flash), Some(Ok(())));
         assert_eq!(fetch(&mut flash, 1), Some(vec![2, 2]));
         assert!(writes.is_empty());
-        assert!(!writes.write_one(&mut flash));
+        assert_eq!(writes.write_one(&mut flash), None);
     }
 
     #[test]
@@ -145,10 +137,10 @@ mod tests {
             queued.store(3, &[value, value]).unwrap();
         }
         assert_eq!(writes.waiting.len(), 2);
-        assert!(writes.write_one(&mut flash));
+        assert_eq!(writes.write_one(&mut flash), Some(Ok(())));
         assert_eq!(fetch(&mut flash, 0xFF), Some(vec![49]));
         assert_eq!(fetch(&mut flash, 3), None);
-        assert!(writes.write_one(&mut flash));
+        assert_eq!(writes.write_one(&mut flash), Some(Ok(())));
         assert_eq!(fetch(&mut flash, 3), Some(vec![49, 49]));
     }
 
@@ -181,7 +173,7 @@ mod tests {
     }
 
     #[test]
-    fn a_failed_write_is_counted_and_not_tried_again() {
+    fn a_failed_write_is_reported_and_not_tried_again() {
         struct Broken;
         impl ParamStore for Broken {
             fn fetch(&mut self, _: u8, _: &mut [u8]) -> Result<Option<usize>, StoreError> {
@@ -197,8 +189,7 @@ mod tests {
             .unwrap()
             .store(1, &[1])
             .unwrap();
-        assert!(writes.write_one(&mut Broken));
-        assert_eq!(writes.failed(), 1);
+        assert_eq!(writes.write_one(&mut Broken), Some(Err(StoreError::Flash)));
         assert!(writes.is_empty());
     }
 }

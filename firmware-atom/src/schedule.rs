@@ -317,14 +317,20 @@ mod tests {
         );
     }
 
-    #[test]
-    fn a_reply_goes_out_first_and_the_next_transaction_right_behind_it() {
+    /// A schedule that has just sent a reply at 10 ms, the wire it went on, and the reply.
+    fn replied() -> (BusSchedule, Wire, Frame) {
         let (settings, mut bank) = at_rest();
         let mut schedule = BusSchedule::new(settings.config().timing.reply_margin_us);
         let mut wire = Wire::default();
         let reply = Frame::new(0x20, &[1]).unwrap();
         schedule.send_reply(reply.clone());
         schedule.start_next(10_000, &mut wire, &mut bank, &settings);
+        (schedule, wire, reply)
+    }
+
+    #[test]
+    fn a_reply_goes_out_first_and_the_next_transaction_right_behind_it() {
+        let (schedule, wire, reply) = replied();
         assert_eq!(wire.written.len(), 2, "{:?}", wire.written);
         assert_eq!(wire.written[0], reply.to_bytes().to_vec());
         assert_eq!(
@@ -339,12 +345,7 @@ mod tests {
     /// last reply is left out of it there (no buffer is returned per byte: docs/boards.md).
     #[test]
     fn heard_frames_fill_the_callers_buffer_without_our_own_echo() {
-        let (settings, mut bank) = at_rest();
-        let mut schedule = BusSchedule::new(settings.config().timing.reply_margin_us);
-        let mut wire = Wire::default();
-        let reply = Frame::new(0x20, &[1]).unwrap();
-        schedule.send_reply(reply.clone());
-        schedule.start_next(10_000, &mut wire, &mut bank, &settings);
+        let (mut schedule, _, reply) = replied();
         let mut events = BusEvents::new();
         for (i, &byte) in reply.to_bytes().iter().enumerate() {
             schedule.hear(10_010 + i as u64 * 10, byte, &mut events);
