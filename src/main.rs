@@ -10,8 +10,9 @@ use std::sync::atomic::AtomicBool;
 
 use clap::Parser;
 use firmware_atom::collision::Collision;
+use firmware_basic::DialectStore;
 use firmware_basic::wifi::WifiConfig;
-use open_mycobot::host::cli::{Cli, default_basic_flash};
+use open_mycobot::host::cli::{Cli, DialectArg, Port, default_basic_flash};
 use open_mycobot::host::emulated::{CONNECT_TIMEOUT, Chardev, EmulatedBoards};
 use open_mycobot::host::pty::PseudoTerminal;
 use open_mycobot::host::pty_link::PtyLink;
@@ -20,6 +21,7 @@ use open_mycobot::host::tcp::TcpServer;
 use open_mycobot::sim::external::EmulatedArm;
 use open_mycobot::sim::{BasicFlashStore, RobotConfig, VirtualRobot};
 use open_mycobot::web::{self, Snapshot, StateBoard, WebServer};
+use protocol_core::dialect::Dialect;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -44,6 +46,13 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
         .as_deref()
         .map(|path| PtyLink::create(path, pty.slave_path()))
         .transpose()?;
+    if cli.dialect == Some(DialectArg::Seed) && cli.port == Port::AtomUsb {
+        return Err(
+            "--dialect seed: the manual's protocol is the Basic's to speak (it \
+                    translates for the Atom); the Atom's own port speaks pymycobot's"
+                .into(),
+        );
+    }
     if let Some(atom) = cli.emulated_atom {
         return serve_emulated(cli, atom, &stop, pty, link);
     }
@@ -92,6 +101,11 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
         Some(path) => writeln!(out, "basic flash {}", path.display())?,
         None => writeln!(out, "basic flash in memory (no $XDG_STATE_HOME or $HOME)")?,
     }
+    let dialect = match cli.dialect {
+        Some(arg) => Dialect::from(arg),
+        None => flash.load_dialect().ok().flatten().unwrap_or_default(),
+    };
+    writeln!(out, "protocol {} (--dialect)", dialect.name())?;
     if let Some(tcp) = &tcp {
         writeln!(out, "tcp on {}", tcp.local_addr()?)?;
     }
@@ -102,10 +116,11 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
         }
         None => {}
     }
-    let config = RobotConfig {
+    let mut config = RobotConfig {
         flash_timing: cli.flash_timing,
         ..RobotConfig::default()
     };
+    config.basic.dialect = cli.dialect.map(Dialect::from);
     let mut robot = VirtualRobot::new(config).with_basic_flash(flash);
     for &obstacle in &cli.obstacles {
         robot.add_obstacle(obstacle);

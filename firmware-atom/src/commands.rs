@@ -611,7 +611,8 @@ fn execute<I: AtomIo>(
         | R::GetTofDistance
         | R::GetBasicVersion
         | R::SetTransponderMode { .. }
-        | R::GetTransponderMode => Answer::Now(Reply::Byte(0)),
+        | R::GetTransponderMode
+        | R::Dialect { .. } => Answer::Now(Reply::Byte(0)),
     }
 }
 

@@ -5,10 +5,12 @@
 //! what a client sees.
 
 use protocol_core::command::{Reply, cmd, is_basic_local};
+use protocol_core::dialect;
 use protocol_core::listener::Listener;
 use protocol_core::{BytePort, Frame};
 
 use crate::config::BasicConfig;
+use crate::dialect::DialectSetting;
 use crate::forwarder::{self, Event, Forwarder};
 use crate::host_link::{HOST_READ_BUDGET, HostFrames, LinkKind};
 use crate::io::BasicIo;
@@ -47,6 +49,8 @@ pub struct Basic {
     supervisor: Supervisor,
     /// The first poll (the Basic's boot) has happened.
     booted: bool,
+    /// The dialect the clients speak.
+    dialect: DialectSetting,
     /// The Wi-Fi, on a board that lends a settings store (from the first poll on).
     wifi: Option<Wifi>,
     /// Wi-Fi settings changes waiting for a quiet bus (at most one per link: a client waits
@@ -68,6 +72,7 @@ impl Basic {
             transparent: Transparent::default(),
             supervisor: Supervisor::new(&config),
             booted: false,
+            dialect: DialectSetting::new(),
             wifi: None,
             wifi_writes: SettingsWrites::new(),
         }
@@ -126,11 +131,22 @@ impl Basic {
             self.bus.assume_busy_until(now_us);
             self.supervisor.boot(now_us, &self.config);
             self.wifi = io.wifi_store().map(|store| Wifi::start(now_us, store));
+            self.dialect.boot(self.config.dialect, io.dialect_store());
+            self.router
+                .set_frame_lengths(self.dialect.get().frame_lengths());
         }
         self.read_bus(now_us, bus);
         self.read_hosts(now_us, hosts, io);
         self.write_wifi_settings(now_us, io);
         let buttons = io.buttons();
+        if self.dialect.on_button(now_us, buttons.c) {
+            self.router
+                .set_frame_lengths(self.dialect.get().frame_lengths());
+        }
+        let quiet = self.forwarder.idle() && !self.router.has_requests();
+        if let Some(Err(_)) = self.dialect.save_when_quiet(quiet, io.dialect_store()) {
+            self.supervisor.error(BasicError::SettingNotSaved);
+        }
         match self.mode {
             Mode::Transparent { owner } if self.forwarder.idle() => {
                 let (supervisor, router) = (&mut self.supervisor, &mut self.router);
@@ -177,6 +193,7 @@ impl Basic {
                 Mode::Transparent { .. } => TransponderMode::Transparent,
             },
             echo_heard: self.bus.echo_heard(),
+            dialect: self.dialect.get(),
             transparent_dropped: self.transparent.dropped,
             ..self.supervisor.status
         }
@@ -264,12 +281,17 @@ impl Basic {
             }
             return;
         }
+        // The client's dialect ends here: the rest of the Basic, and the Atom, read pymycobot's.
+        let dialect = self.dialect.get();
+        let dialect::Translated { frame, answer } = dialect.translate(&frame);
         let code = frame.cmd();
         if let Mode::Transparent { .. } = self.mode {
             // The bus is another client's: the Basic's own commands are still answered (0xC3
             // says why the rest is not), 0xC2 is that client's to send.
             if code == cmd::SET_TRANSPONDER_MODE {
-                self.send_frame(link, &Reply::Byte(0).to_frame(code));
+                if let Some(refusal) = dialect::refusal(dialect, code) {
+                    self.send_frame(link, &refusal);
+                }
                 return;
             }
             if !is_basic_local(code) {
@@ -283,8 +305,14 @@ impl Basic {
             self.queue_wifi_write(now_us, link, SettingsChange::Frame(frame));
             return;
         }
-        if let Some(answer) = local::answer(&frame, io, self.local_context(now_us)) {
+        if let Some(local) = local::answer(&frame, io, self.local_context(now_us)) {
+            let answer = local.in_dialect(answer);
             self.send_answer(link, &answer);
+            if let Some(new) = answer.new_dialect
+                && self.dialect.set(new)
+            {
+                self.router.set_frame_lengths(new.frame_lengths());
+            }
             if answer.capture_text {
                 self.router.start_capture(now_us, link);
             }
@@ -296,7 +324,7 @@ impl Basic {
         let Some(client) = self.router.client(link) else {
             return;
         };
-        if self.router.push(client, frame, now_us).is_err() {
+        if self.router.push(client, frame, answer, now_us).is_err() {
             self.supervisor.error(BasicError::QueueFull { cmd: code });
         }
     }
@@ -306,6 +334,7 @@ impl Basic {
         local::Context {
             version_x10: self.config.version_x10,
             mode: self.status().mode,
+            dialect: self.dialect.get(),
             wifi: self.wifi.as_mut(),
             now_us,
         }
@@ -316,6 +345,7 @@ impl Basic {
         let sent = match &answer.body {
             local::AnswerBody::Frame(frame) => self.router.send_frame(link, frame),
             local::AnswerBody::Text(bytes) => self.router.send_bytes(link, bytes),
+            local::AnswerBody::Nothing => true,
         };
         if !sent {
             self.supervisor.error(BasicError::HostOverflow);
@@ -345,7 +375,9 @@ impl Basic {
         {
             let answer = match change {
                 SettingsChange::Frame(frame) => {
+                    let dialect = self.dialect.get().translate(&frame).answer;
                     local::answer(&frame, io, self.local_context(now_us))
+                        .map(|a| a.in_dialect(dialect))
                 }
                 SettingsChange::Text(end) => {
                     local::answer_set_text(end, io, self.wifi.as_mut(), now_us)
@@ -412,6 +444,7 @@ impl Basic {
 fn deliver(now_us: u64, event: Event, supervisor: &mut Supervisor, router: &mut Router) {
     supervisor.on_event(now_us, &event);
     if let Event::Reply { request, reply } = event
+        && let Some(reply) = request.answer.reply(&reply)
         && let Some(delivery) = router.deliver(request.origin, &reply)
     {
         supervisor.on_delivery(delivery);

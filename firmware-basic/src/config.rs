@@ -31,6 +31,9 @@ pub struct BasicConfig {
     pub power_on_at_boot: bool,
     /// The version the Basic reports for 0xC1, times ten (10 = "1.0").
     pub version_x10: u8,
+    /// The dialect to speak from boot (the virtual robot's `--dialect`), kept in the store
+    /// too; `None`: the stored one, or pymycobot's.
+    pub dialect: Option<protocol_core::dialect::Dialect>,
 }
 
 impl Default for BasicConfig {
@@ -44,6 +47,7 @@ impl Default for BasicConfig {
             probe_interval_us: 1_000_000,
             power_on_at_boot: true,
             version_x10: 10,
+            dialect: None,
         }
     }
 }

@@ -571,6 +571,7 @@ mod tests {
         let request = |origin| Request {
             frame: Frame::new(cmd::GET_ANGLES, &[]).unwrap(),
             origin,
+            answer: protocol_core::dialect::Answer::AsIs,
             queued_us: 0,
         };
         let client = crate::request::Client::new(crate::request::LinkId::USB, 0);

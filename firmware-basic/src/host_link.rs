@@ -131,6 +131,11 @@ impl HostLink {
         self.rx.on_time(now_us, &mut |heard| collect(heard, frames));
     }
 
+    /// Reads LEN as `lengths` says (the clients' dialect), from the next frame on.
+    pub(crate) fn set_frame_lengths(&mut self, lengths: protocol_core::frame::FrameLengths) {
+        self.rx.set_frame_lengths(lengths);
+    }
+
     /// Forgets any partial frame (when the mode changes).
     pub(crate) fn reset_framer(&mut self) {
         self.rx.drop_partials();

@@ -3,6 +3,7 @@
 
 use protocol_core::command::{BasicInputPin, BasicOutputPin};
 
+use crate::dialect::DialectStore;
 use crate::wifi::WifiStore;
 
 /// User output pins a client may drive with 0xA0 (GPIO5 drives the suction-pump valve).
@@ -43,6 +44,12 @@ pub trait BasicIo {
     /// boot (the settings are loaded then) and for every Wi-Fi command; a board with Wi-Fi
     /// always lends the same store.
     fn wifi_store(&mut self) -> Option<&mut dyn WifiStore> {
+        None
+    }
+
+    /// Where the dialect is kept (the board's flash, beside the Wi-Fi settings; a file in the
+    /// virtual robot). `None` (the default): a change lasts until power-off.
+    fn dialect_store(&mut self) -> Option<&mut dyn DialectStore> {
         None
     }
 }

@@ -98,6 +98,7 @@
 mod basic;
 pub mod clients;
 pub mod config;
+pub mod dialect;
 pub mod forwarder;
 pub mod host_link;
 pub mod io;
@@ -112,6 +113,7 @@ pub mod wifi;
 pub use basic::{BUS_READ_BUDGET, Basic};
 pub use clients::{NetClient, NetworkClients};
 pub use config::{BasicConfig, ConfigError, EchoMode};
+pub use dialect::DialectStore;
 pub use host_link::LinkKind;
 pub use io::{BasicIo, Buttons, NullIo};
 pub use request::{LinkId, MAX_HOST_LINKS};

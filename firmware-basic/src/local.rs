@@ -26,6 +26,7 @@ use protocol_core::command::{CommandError, Reply, Request, cmd, is_basic_local};
 use crate::io::BasicIo;
 use crate::status::{BasicError, TransponderMode};
 use crate::wifi::{MAX_GET_TEXT, SetTextEnd, Wifi, WifiAnswer, WifiReply};
+use protocol_core::dialect::{Answer, Dialect};
 
 /// What 0xB1 answers on a board without Wi-Fi: no network configured, in the text form
 /// pymycobot parses.
@@ -42,6 +43,8 @@ pub(crate) struct LocalAnswer {
     pub(crate) body: AnswerBody,
     /// The transponder mode to switch to after the reply.
     pub(crate) new_mode: Option<TransponderMode>,
+    /// The dialect switched to (0xC5): the reply already names it.
+    pub(crate) new_dialect: Option<Dialect>,
     /// What went wrong, for the display.
     pub(crate) error: Option<BasicError>,
     /// The request was 0xB0's announcing frame, acknowledged: the link's next bytes are the
@@ -56,6 +59,8 @@ pub(crate) enum AnswerBody {
     Frame(Frame),
     /// Bare text (0xB1).
     Text(Vec<u8, MAX_GET_TEXT>),
+    /// Nothing: the client's dialect expects no reply.
+    Nothing,
 }
 
 impl LocalAnswer {
@@ -63,6 +68,7 @@ impl LocalAnswer {
         Self {
             body: AnswerBody::Frame(data.to_frame(cmd)),
             new_mode: None,
+            new_dialect: None,
             error: None,
             capture_text: false,
         }
@@ -75,9 +81,21 @@ impl LocalAnswer {
                 WifiReply::Text(text) => AnswerBody::Text(text),
             },
             new_mode: None,
+            new_dialect: None,
             error: answer.error.map(BasicError::Wifi),
             capture_text: answer.capture_text,
         }
+    }
+
+    /// This answer as a client of a dialect gets it (`answer`, from its request's
+    /// translation): a frame changed or dropped, text as it is.
+    pub(crate) fn in_dialect(mut self, answer: Answer) -> Self {
+        if let AnswerBody::Frame(reply) = &self.body {
+            self.body = answer
+                .reply(reply)
+                .map_or(AnswerBody::Nothing, AnswerBody::Frame);
+        }
+        self
     }
 
     /// The status reply: `01` done, `00` refused.
@@ -97,6 +115,8 @@ pub(crate) struct Context<'a> {
     pub(crate) version_x10: u8,
     /// The transponder mode (0xC3).
     pub(crate) mode: TransponderMode,
+    /// The dialect in force (0xC5).
+    pub(crate) dialect: Dialect,
     /// The Wi-Fi (0xB0..0xB2), if the board has it.
     pub(crate) wifi: Option<&'a mut Wifi>,
     /// The time, microseconds.
@@ -141,6 +161,7 @@ pub(crate) fn answer<I: BasicIo>(
             LocalAnswer {
                 body: AnswerBody::Text(text),
                 new_mode: None,
+                new_dialect: None,
                 error: None,
                 capture_text: false,
             }
@@ -157,6 +178,10 @@ pub(crate) fn answer<I: BasicIo>(
             ..LocalAnswer::status(code, true)
         },
         Ok(Request::GetTransponderMode) => LocalAnswer::frame(code, Reply::Byte(mode as u8)),
+        Ok(Request::Dialect { set }) => LocalAnswer {
+            new_dialect: set,
+            ..LocalAnswer::frame(code, Reply::Byte(set.unwrap_or(cx.dialect) as u8))
+        },
         Err(CommandError::BadPin(pin)) if code == cmd::GET_BASIC_INPUT => {
             pin_unreadable(code, pin).with_error(BasicError::InvalidPin { pin })
         }
@@ -224,6 +249,7 @@ mod tests {
         let cx = Context {
             version_x10: 12,
             mode: TransponderMode::Framed,
+            dialect: Dialect::Pymycobot,
             wifi: None,
             now_us: 0,
         };
@@ -234,6 +260,7 @@ mod tests {
         match &answer.body {
             AnswerBody::Frame(f) => f.to_bytes().to_vec(),
             AnswerBody::Text(bytes) => bytes.to_vec(),
+            AnswerBody::Nothing => std::vec::Vec::new(),
         }
     }
 

@@ -7,6 +7,7 @@
 //! other.
 
 use protocol_core::Frame;
+use protocol_core::dialect::Answer;
 
 /// Most host links open at once, the USB link included: the USB serial and seven network
 /// clients. An ESP32's network stack serves about ten sockets (one listens); every link costs
@@ -84,6 +85,9 @@ pub(crate) enum Origin {
 pub(crate) struct Request {
     pub(crate) frame: Frame,
     pub(crate) origin: Origin,
+    /// What the client gets for the reply (its dialect's answer; the Basic's own requests:
+    /// as it is).
+    pub(crate) answer: Answer,
     /// When it arrived (or was made), in microseconds.
     pub(crate) queued_us: u64,
 }

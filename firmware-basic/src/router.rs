@@ -25,6 +25,8 @@
 //! USB one, so a board with one UART passes just that.
 
 use heapless::{Deque, Vec};
+use protocol_core::dialect::Answer;
+use protocol_core::frame::FrameLengths;
 use protocol_core::{BytePort, Frame};
 
 use crate::host_link::{HostFrames, HostLink, LinkKind};
@@ -84,6 +86,7 @@ impl<P: BytePort> HostPorts for P {
 #[derive(Debug)]
 struct Waiting {
     frame: Frame,
+    answer: Answer,
     /// When it arrived, in microseconds.
     arrived_us: u64,
 }
@@ -127,6 +130,8 @@ pub(crate) struct Router {
     slots: [Slot; MAX_HOST_LINKS],
     /// The index of the link whose request goes next, if it has one.
     turn: usize,
+    /// How every link reads LEN (the clients' dialect).
+    lengths: FrameLengths,
 }
 
 impl Router {
@@ -135,6 +140,15 @@ impl Router {
         Self {
             slots: core::array::from_fn(|i| Slot::new(LinkKind::Serial, i == LinkId::USB.index())),
             turn: 0,
+            lengths: FrameLengths::Counted,
+        }
+    }
+
+    /// Every link reads LEN as `lengths` says, from its next frame on.
+    pub(crate) fn set_frame_lengths(&mut self, lengths: FrameLengths) {
+        self.lengths = lengths;
+        for slot in &mut self.slots {
+            slot.link.set_frame_lengths(lengths);
         }
     }
 
@@ -147,6 +161,7 @@ impl Router {
             .find(|(_, slot)| !slot.open)
             .ok_or(LinksFull)?;
         slot.restart(kind, true);
+        slot.link.set_frame_lengths(self.lengths);
         LinkId::from_index(index).ok_or(LinksFull)
     }
 
@@ -156,6 +171,7 @@ impl Router {
         if let Some(slot) = self.slots.get_mut(link.index()) {
             let kind = slot.link.kind();
             slot.restart(kind, link == LinkId::USB);
+            slot.link.set_frame_lengths(self.lengths);
         }
     }
 
@@ -260,7 +276,13 @@ impl Router {
 
     /// Queues `frame` from `client` for the Atom, arrived at `now_us`; gives it back if the
     /// client's queue is full (or the client has gone).
-    pub(crate) fn push(&mut self, client: Client, frame: Frame, now_us: u64) -> Result<(), Frame> {
+    pub(crate) fn push(
+        &mut self,
+        client: Client,
+        frame: Frame,
+        answer: Answer,
+        now_us: u64,
+    ) -> Result<(), Frame> {
         match self
             .slots
             .get_mut(client.link.index())
@@ -270,6 +292,7 @@ impl Router {
                 .waiting
                 .push_back(Waiting {
                     frame,
+                    answer,
                     arrived_us: now_us,
                 })
                 .map_err(|w| w.frame),
@@ -311,6 +334,7 @@ impl Router {
             let request = |waiting: Waiting| Request {
                 frame: waiting.frame,
                 origin: Origin::Host(client),
+                answer: waiting.answer,
                 queued_us: waiting.arrived_us,
             };
             // Expired requests go even while the link's output is full, so they do not hold
@@ -415,16 +439,16 @@ mod tests {
         let b = router.open(LinkKind::Network).unwrap();
         for cmd in [0x20, 0x21, 0x22] {
             let usb = router.client(LinkId::USB).unwrap();
-            router.push(usb, frame(cmd), 0).unwrap();
+            router.push(usb, frame(cmd), Answer::AsIs, 0).unwrap();
         }
         router
-            .push(router.client(a).unwrap(), frame(0x30), 0)
+            .push(router.client(a).unwrap(), frame(0x30), Answer::AsIs, 0)
             .unwrap();
         router
-            .push(router.client(b).unwrap(), frame(0x40), 0)
+            .push(router.client(b).unwrap(), frame(0x40), Answer::AsIs, 0)
             .unwrap();
         router
-            .push(router.client(b).unwrap(), frame(0x41), 0)
+            .push(router.client(b).unwrap(), frame(0x41), Answer::AsIs, 0)
             .unwrap();
         assert_eq!(
             cmds_in_turn(&mut router, 1),
@@ -472,10 +496,10 @@ mod tests {
         let mut router = Router::new();
         let net = router.open(LinkKind::Network).unwrap();
         router
-            .push(router.client(net).unwrap(), frame(0x30), 0)
+            .push(router.client(net).unwrap(), frame(0x30), Answer::AsIs, 0)
             .unwrap();
         let usb = router.client(LinkId::USB).unwrap();
-        router.push(usb, frame(0x20), 0).unwrap();
+        router.push(usb, frame(0x20), Answer::AsIs, 0).unwrap();
         let mut expired = std::vec::Vec::new();
         let now = LinkKind::Network.client_deadline_us() + 1;
         let sent: std::vec::Vec<u8> =
@@ -493,7 +517,7 @@ mod tests {
         // The client does not read: its output queue is nearly full.
         assert!(router.send_bytes(net, &[0; 500]));
         router
-            .push(router.client(net).unwrap(), frame(0x30), 0)
+            .push(router.client(net).unwrap(), frame(0x30), Answer::AsIs, 0)
             .unwrap();
         assert!(
             router.next_request(1, |_| {}).is_none(),

@@ -49,6 +49,8 @@ pub enum BasicError {
     /// Bytes for the host were dropped because the host link could not keep up (in
     /// transparent mode a busy bus outpaces the 115200 host link; the oldest bytes go).
     HostOverflow,
+    /// The dialect could not be written to flash: it is in force until power-off.
+    SettingNotSaved,
     /// A Wi-Fi command was refused or its flash write failed (the client got `00`; nothing
     /// changed).
     Wifi(WifiError),
@@ -62,6 +64,8 @@ pub struct BasicStatus {
     /// Framed (host frames checked, own commands answered, the rest forwarded one request at
     /// a time) or transparent (raw bytes both ways until `FE FE 03 C2 00 FA`).
     pub mode: TransponderMode,
+    /// The dialect the clients speak (`docs/protocol.md`, "Dialects").
+    pub dialect: protocol_core::dialect::Dialect,
     /// Whether the Atom answers.
     pub atom: AtomLink,
     /// The Atom's power state from its last 0x10/0x11/0x12 answer, if known.
@@ -91,6 +95,7 @@ impl Default for BasicStatus {
         Self {
             version_x10: 0,
             mode: TransponderMode::Framed,
+            dialect: protocol_core::dialect::Dialect::Pymycobot,
             atom: AtomLink::Unknown,
             atom_powered: None,
             echo_heard: None,

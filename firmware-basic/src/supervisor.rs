@@ -142,6 +142,7 @@ impl Supervisor {
             // Cannot fail: no data.
             frame: Frame::new(cmd, &[]).unwrap_or_default(),
             origin,
+            answer: protocol_core::dialect::Answer::AsIs,
             queued_us: now_us,
         })
     }
@@ -295,6 +296,7 @@ mod tests {
         Request {
             frame: Frame::new(code, &[]).unwrap(),
             origin,
+            answer: protocol_core::dialect::Answer::AsIs,
             queued_us: 0,
         }
     }

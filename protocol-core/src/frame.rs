@@ -110,6 +110,87 @@ impl core::fmt::Debug for Frame {
 #[derive(Clone, Debug)]
 pub struct FrameDecoder {
     scanner: Scanner<MAX_FRAME_BYTES>,
+    lengths: FrameLengths,
+}
+
+/// How a [`FrameDecoder`] reads LEN.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum FrameLengths {
+    /// LEN = len(DATA) + 2, always (`protocol.md` section 2).
+    #[default]
+    Counted,
+    /// As [`Counted`](Self::Counted), and the seed manual's miscounted LENs are accepted
+    /// where they cannot mean anything else ([`SEED_MISCOUNTS`]): the frame ends at the first
+    /// `FA` among the lengths that command really has and the LEN printed.
+    SeedManual,
+}
+
+/// The LENs the seed manual prints wrong in its request examples (`docs/protocol.md`,
+/// "Dialects"): the command, the LEN as printed, and the data lengths the command really
+/// has. 0x2A and 0x3C print decimal 15 as `0x15`, 0x81 and 0x83 decimal 14 as `0x14`, 0x41 sends
+/// its speed byte under LEN 2 and 0x50 ("check connection") has no data under LEN 3.
+pub const SEED_MISCOUNTS: [(u8, u8, &[u8]); 6] = [
+    (0x2A, 0x15, &[12, 13]),
+    (0x3C, 0x15, &[13]),
+    (0x81, 0x14, &[12]),
+    (0x83, 0x14, &[12]),
+    (0x41, 0x02, &[1]),
+    (0x50, 0x03, &[0]),
+];
+
+/// The data lengths a seed-manual frame with `cmd` and `len` really has, besides LEN's own.
+fn seed_miscount(cmd: u8, len: u8) -> Option<&'static [u8]> {
+    SEED_MISCOUNTS
+        .iter()
+        .find(|(c, l, _)| *c == cmd && *l == len)
+        .map(|(_, _, real)| *real)
+}
+
+/// Host frames as the seed manual prints them: [`HostFrames`] plus [`SEED_MISCOUNTS`].
+struct SeedFrames;
+
+impl Format for SeedFrames {
+    const HEADER: u8 = HEADER;
+
+    fn scan(b: &[u8]) -> Scan {
+        let (Some(&len), Some(&cmd)) = (b.get(2), b.get(3)) else {
+            return HostFrames::scan(b);
+        };
+        let Some(real) = seed_miscount(cmd, len).filter(|_| b.starts_with(&[HEADER, HEADER]))
+        else {
+            return HostFrames::scan(b);
+        };
+        // Every candidate end, shortest first: the first one with FA there is the frame.
+        let printed = len - 2;
+        let mut lengths = real
+            .iter()
+            .copied()
+            .chain(Some(printed))
+            .collect::<Vec<u8, 4>>();
+        lengths.sort_unstable();
+        for data_len in lengths {
+            let end = 4 + data_len as usize;
+            match b.get(end) {
+                None => return Scan::NeedMore,
+                Some(&FOOTER) => return Scan::Complete(end + 1),
+                Some(_) => {}
+            }
+        }
+        Scan::Reject
+    }
+
+    fn missing(b: &[u8]) -> usize {
+        match (b.get(2), b.get(3)) {
+            (Some(&len), Some(&cmd)) => match seed_miscount(cmd, len) {
+                Some(real) => {
+                    let shortest = real.iter().copied().chain(Some(len - 2)).min().unwrap_or(0);
+                    (5 + shortest as usize).saturating_sub(b.len()).max(1)
+                }
+                None => HostFrames::missing(b),
+            },
+            _ => 1,
+        }
+    }
 }
 
 impl Default for FrameDecoder {
@@ -162,7 +243,19 @@ impl FrameDecoder {
     pub const fn new() -> Self {
         Self {
             scanner: Scanner::new(),
+            lengths: FrameLengths::Counted,
         }
+    }
+
+    /// Reads LEN as `lengths` says from the next frame on; a frame already begun is read the
+    /// same way once it is complete.
+    pub fn set_lengths(&mut self, lengths: FrameLengths) {
+        self.lengths = lengths;
+    }
+
+    /// How this decoder reads LEN.
+    pub fn lengths(&self) -> FrameLengths {
+        self.lengths
     }
 
     /// Appends one received byte; returns the frame it completes, if any.
@@ -177,13 +270,23 @@ impl FrameDecoder {
     /// it skips straight to the next `FE`, and once a candidate's LEN is known it copies the
     /// rest of the candidate in one go.
     pub fn feed(&mut self, bytes: &[u8], on_frame: impl FnMut(Frame)) {
-        self.scanner
-            .feed::<HostFrames, _>(bytes, frame_from, on_frame);
+        match self.lengths {
+            FrameLengths::Counted => self
+                .scanner
+                .feed::<HostFrames, _>(bytes, frame_from, on_frame),
+            FrameLengths::SeedManual => {
+                self.scanner
+                    .feed::<SeedFrames, _>(bytes, frame_from, on_frame);
+            }
+        }
     }
 
     /// Returns the next complete frame already in the buffer, if any.
     pub fn next_frame(&mut self) -> Option<Frame> {
-        self.scanner.next::<HostFrames, _>(frame_from)
+        match self.lengths {
+            FrameLengths::Counted => self.scanner.next::<HostFrames, _>(frame_from),
+            FrameLengths::SeedManual => self.scanner.next::<SeedFrames, _>(frame_from),
+        }
     }
 
     /// Tells the decoder the line has been quiet long enough that a frame in progress was cut

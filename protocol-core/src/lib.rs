@@ -1,6 +1,8 @@
 //! The two protocols that travel on a myCobot 280 M5's wires, typed and zero-allocation.
 //!
 //! * [`command`]: what each host frame means: typed requests and replies, error codes.
+//! * [`dialect`]: the two ways clients speak the host protocol (pymycobot's and the vendor
+//!   manual's), as translations into the one the rest of this crate implements.
 //! * [`frame`]: host frames `FE FE LEN CMD DATA FA` and a streaming decoder that finds them in
 //!   any byte stream (any chunking, garbage, servo packets on the same wire).
 //! * [`servo`]: Feetech STS servo packets `FF FF ID LEN ...`, their checksum, register values
@@ -16,6 +18,7 @@
 #![forbid(unsafe_code)]
 
 pub mod command;
+pub mod dialect;
 pub mod frame;
 pub mod listener;
 pub mod port;

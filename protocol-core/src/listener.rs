@@ -310,6 +310,12 @@ impl Listener {
         }
     }
 
+    /// Reads host frames' LEN as `lengths` says from the next frame on (a host link's
+    /// dialect: [`crate::dialect::Dialect::frame_lengths`]).
+    pub fn set_frame_lengths(&mut self, lengths: crate::frame::FrameLengths) {
+        self.frames.set_lengths(lengths);
+    }
+
     /// Forgets every frame and packet in progress, and whatever complete one a rescan would
     /// find inside them: for a station that knows the line is quiet before it transmits (a
     /// partial candidate must not swallow the answer), or that changes what the line means.

@@ -12,6 +12,7 @@
 
 use proptest::prelude::*;
 use proptest::strategy::Union;
+use protocol_core::dialect::Dialect;
 
 use protocol_core::command::*;
 use protocol_core::servo::{Packet, PacketDecoder};
@@ -402,6 +403,9 @@ fn request_of(kind: RequestKind) -> BoxedStrategy<Request> {
         .prop_map(|mode| R::SetTransponderMode { mode })
         .boxed(),
         K::GetTransponderMode => Just(R::GetTransponderMode).boxed(),
+        K::Dialect => prop::option::of(prop::sample::select(Dialect::ALL.to_vec()))
+            .prop_map(|set| R::Dialect { set })
+            .boxed(),
         // --- drag teaching ---
         K::DragStartRecord => Just(R::DragStartRecord).boxed(),
         K::DragEndRecord => Just(R::DragEndRecord).boxed(),

@@ -38,6 +38,13 @@ pub struct Cli {
     #[arg(long, value_name = "PATH")]
     pub basic_flash: Option<PathBuf>,
 
+    /// The protocol dialect the Basic's clients speak from the start (docs/protocol.md,
+    /// "Dialects"): pymycobot's, or the vendor manual's (`seed`: set commands unanswered,
+    /// joints numbered from 0, 0x28 stops). Kept in the Basic's flash like the board's button
+    /// C setting; without it, the stored dialect (pymycobot's at first).
+    #[arg(long, value_enum)]
+    pub dialect: Option<DialectArg>,
+
     /// Which board's USB serial the clients talk to: the Basic (as with the real arm's USB
     /// cable) or the Atom's own USB port (a direct link to the arm's controller).
     #[arg(long, value_enum, default_value_t = Port::Basic)]
@@ -98,6 +105,24 @@ pub fn default_basic_flash() -> Option<PathBuf> {
                 .map(|home| PathBuf::from(home).join(".local/state"))
         })?;
     Some(state.join("open-mycobot/basic-flash.bin"))
+}
+
+/// A protocol dialect, as the command line names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DialectArg {
+    /// pymycobot's protocol (every command answered).
+    Pymycobot,
+    /// The vendor manual's protocol.
+    Seed,
+}
+
+impl From<DialectArg> for protocol_core::dialect::Dialect {
+    fn from(arg: DialectArg) -> Self {
+        match arg {
+            DialectArg::Pymycobot => Self::Pymycobot,
+            DialectArg::Seed => Self::Seed,
+        }
+    }
 }
 
 /// A USB serial port of the virtual arm.

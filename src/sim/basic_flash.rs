@@ -11,6 +11,7 @@ use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
 
+use firmware_basic::DialectStore;
 use firmware_basic::wifi::{FlashWifiStore, LoadError, WifiSettings, WifiStore};
 use flash_store::{MemFlash, StoreError};
 
@@ -108,6 +109,24 @@ impl WifiStore for BasicFlashStore {
     fn save(&mut self, settings: &WifiSettings) -> Result<(), StoreError> {
         let before = self.store.clone();
         self.store.save(settings)?;
+        if let Some(path) = &self.file
+            && self.write_file(path).is_err()
+        {
+            self.store = before;
+            return Err(StoreError::Flash);
+        }
+        Ok(())
+    }
+}
+
+impl DialectStore for BasicFlashStore {
+    fn load_dialect(&mut self) -> Result<Option<protocol_core::dialect::Dialect>, StoreError> {
+        self.store.load_dialect()
+    }
+
+    fn save_dialect(&mut self, dialect: protocol_core::dialect::Dialect) -> Result<(), StoreError> {
+        let before = self.store.clone();
+        self.store.save_dialect(dialect)?;
         if let Some(path) = &self.file
             && self.write_file(path).is_err()
         {

@@ -164,6 +164,10 @@ impl BasicIo for SimBoardIo<'_> {
     fn wifi_store(&mut self) -> Option<&mut dyn WifiStore> {
         Some(self.flash)
     }
+
+    fn dialect_store(&mut self) -> Option<&mut dyn firmware_basic::DialectStore> {
+        Some(self.flash)
+    }
 }
 
 /// When a board's main loop runs next (see [`RobotConfig::atom_loop_us`]).

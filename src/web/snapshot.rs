@@ -8,6 +8,7 @@ use firmware_atom::collision::Kind;
 use kinematics_core::ArmGeometry;
 use kinematics_core::geometry::DH_ALPHA_CENTIDEG;
 use protocol_core::command::{EndType, Pose, ReferenceFrame};
+use protocol_core::dialect::Dialect;
 use protocol_core::units::Centideg;
 
 use crate::host::realtime::Lateness;
@@ -38,6 +39,8 @@ pub struct Snapshot {
     pub powered: bool,
     /// Whether the Atom is running a motion.
     pub moving: bool,
+    /// The dialect the Basic's clients speak; `None` without a Basic (the Atom's own port).
+    pub dialect: Option<Dialect>,
     /// The collision the Atom detected and the host has not cleared yet.
     pub collision: Option<CollisionMark>,
     /// How late the simulation has run behind the wall clock because the machine could not
@@ -80,6 +83,7 @@ impl Snapshot {
             led_rgb: robot.atom_io().rgb,
             powered: atom.is_powered(),
             moving: atom.is_moving(),
+            dialect: robot.basic().map(|basic| basic.status().dialect),
             collision: atom.collision().and_then(|latched| {
                 let &(at_ns, logged) = robot.collisions().last()?;
                 (logged == latched).then(|| CollisionMark {
@@ -104,8 +108,10 @@ impl Snapshot {
     ///  "coords":[x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg],"end":"flange","frame":"base",
     ///  "tool":null,"gripper":50,"led":[255,0,0],"powered":true,"moving":false,
     ///  "collision":{"joint":2,"code":16,"during":"moving joints","t_s":3.25},
-    ///  "late_ms":0,"late_stalls":0}
+    ///  "late_ms":0,"late_stalls":0,"protocol":"pymycobot"}
     /// ```
+    ///
+    /// `protocol`: the dialect the Basic's clients speak, or `null` without a Basic.
     ///
     /// `collision`: the collision not cleared yet ([`CollisionMark`]), or `null`.
     ///
@@ -152,10 +158,16 @@ impl Snapshot {
         }
         let _ = write!(
             out,
-            ",\"late_ms\":{},\"late_stalls\":{}}}",
+            ",\"late_ms\":{},\"late_stalls\":{},\"protocol\":",
             self.late.total_us as f64 / 1e3,
             self.late.stalls
         );
+        match self.dialect {
+            Some(d) => {
+                let _ = write!(out, "\"{}\"}}", d.name());
+            }
+            None => out.push_str("null}"),
+        }
         out
     }
 }
@@ -270,6 +282,7 @@ mod tests {
             led_rgb: (255, 0, 16),
             powered: true,
             moving: false,
+            dialect: Some(Dialect::Seed),
             collision: Some(CollisionMark {
                 joint: 2,
                 kind: Kind::JointMotion,
@@ -297,6 +310,7 @@ mod tests {
                 "collision": {"joint": 2.0, "code": 16.0, "during": "moving joints", "t_s": 3.25},
                 "late_ms": 1.25,
                 "late_stalls": 2.0,
+                "protocol": "seed",
             }))
         );
     }
@@ -314,6 +328,7 @@ mod tests {
             led_rgb: (0, 0, 0),
             powered: false,
             moving: true,
+            dialect: None,
             collision: None,
             late: Lateness {
                 total_us: u64::MAX,
@@ -327,6 +342,7 @@ mod tests {
         assert_eq!(value["tool"], Value::Null);
         assert_eq!(value["end"], json!("flange"));
         assert_eq!(value["collision"], Value::Null);
+        assert_eq!(value["protocol"], Value::Null);
     }
 
     #[test]

@@ -106,6 +106,23 @@ impl<F: NorFlash> WifiStore for FlashWifiStore<F> {
     }
 }
 
+impl<F: NorFlash> crate::dialect::DialectStore for FlashWifiStore<F> {
+    fn load_dialect(&mut self) -> Result<Option<protocol_core::dialect::Dialect>, StoreError> {
+        self.region.with_store(|store| {
+            let mut record = [0u8; 1];
+            match store.fetch(crate::dialect::DIALECT_KEY, &mut record)? {
+                Some(1) => Ok(protocol_core::dialect::Dialect::from_u8(record[0])),
+                _ => Ok(None),
+            }
+        })
+    }
+
+    fn save_dialect(&mut self, dialect: protocol_core::dialect::Dialect) -> Result<(), StoreError> {
+        self.region
+            .with_store(|store| store.store(crate::dialect::DIALECT_KEY, &[dialect as u8]))
+    }
+}
+
 /// Why a change of the settings was not made. Either way nothing changed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ChangeError {

@@ -817,6 +817,20 @@ requests! {
         emit |w| { w.u8(*mode as u8); };
         /// 0xC3 get transponder mode.
         GetTransponderMode = cmd::GET_TRANSPONDER_MODE, reply ReplyKind::Byte;
+        /// 0xC5 the protocol dialect: LEN 2 asks, LEN 3 sets. Answered in both dialects with
+        /// the dialect in force.
+        Dialect {
+            /// The dialect to switch to; `None` asks.
+            set: Option<crate::dialect::Dialect>,
+        } = cmd::DIALECT, reply ReplyKind::Byte,
+        data 0 | 1 => |f| Self::Dialect {
+            set: f.optional(|f| f.enum_byte(crate::dialect::Dialect::from_u8))?,
+        },
+        emit |w| {
+            if let Some(d) = set {
+                w.u8(*d as u8);
+            }
+        };
 
         // --- drag teaching ---
 

@@ -30,6 +30,7 @@ function showReadout(state) {
   $('led-swatch').style.background = hex;
   $('led').textContent = hex;
   const status = [state.powered ? 'powered on' : 'powered off', state.moving ? 'moving' : 'at rest'];
+  if (state.protocol) status.push(`${state.protocol} protocol`);
   if (state.late_stalls > 0) {
     // The machine could not keep the simulation in real time: it ran this much late.
     status.push(`ran ${state.late_ms.toFixed(0)} ms late (${state.late_stalls} stalls)`);
@@ -120,7 +121,7 @@ let scheduled = false;
 // Everything in a state message that is read out or drawn, except the time: an arm at rest
 // sends the same key 60 times a second, and then the page does nothing.
 const keyOf = (s) =>
-  JSON.stringify([s.angles_deg, s.coords, s.end, s.frame, s.tool, s.gripper, s.led, s.powered, s.moving, s.collision, s.late_stalls]);
+  JSON.stringify([s.angles_deg, s.coords, s.end, s.frame, s.tool, s.gripper, s.led, s.powered, s.moving, s.collision, s.late_stalls, s.protocol]);
 
 function schedule() {
   if (!scheduled) {

@@ -80,4 +80,11 @@ impl BasicIo for BoardIo<'_> {
     fn wifi_store(&mut self) -> Option<&mut dyn WifiStore> {
         self.wifi.as_mut().map(|store| store as &mut dyn WifiStore)
     }
+
+    #[cfg(feature = "wifi")]
+    fn dialect_store(&mut self) -> Option<&mut dyn firmware_basic::DialectStore> {
+        self.wifi
+            .as_mut()
+            .map(|store| store as &mut dyn firmware_basic::DialectStore)
+    }
 }

@@ -152,8 +152,12 @@ fn write_row(out: &mut Line, row: usize, s: &BasicStatus) -> fmt::Result {
         ),
         4 => write!(out, "power     {}", yes_no(s.atom_powered, "on", "off")),
         5 => write!(out, "bus echo  {}", yes_no(s.echo_heard, "heard", "none")),
-        6 => write!(out, "host frames {}", s.host_frames),
-        7 => write!(out, "replies     {}", s.replies_forwarded),
+        6 => write!(
+            out,
+            "frames {}  replies {}",
+            s.host_frames, s.replies_forwarded
+        ),
+        7 => write!(out, "protocol  {} (hold C 2s)", s.dialect.name()),
         8 => write!(out, "timeouts {}  collisions {}", s.timeouts, s.collisions),
         ERROR_ROW => match s.last_error {
             None => Ok(()),
@@ -165,6 +169,7 @@ fn write_row(out: &mut Line, row: usize, s: &BasicStatus) -> fmt::Result {
             }
             Some(BasicError::InvalidPin { pin }) => write!(out, "no such pin {pin}"),
             Some(BasicError::HostOverflow) => write!(out, "host link overflow"),
+            Some(BasicError::SettingNotSaved) => write!(out, "protocol not saved to flash"),
             Some(BasicError::Wifi(WifiError::Refused(why))) => write!(out, "wifi: {why}"),
             Some(BasicError::Wifi(WifiError::Flash(_))) => write!(out, "wifi: flash write failed"),
         },
@@ -304,6 +309,7 @@ mod tests {
         assert_eq!(row_text(&text, 3), "atom      SILENT");
         assert_eq!(row_text(&text, 4), "power     on");
         assert_eq!(row_text(&text, 5), "bus echo  ?");
+        assert_eq!(row_text(&text, 7), "protocol  pymycobot (hold C 2s)");
         assert_eq!(row_text(&text, 8), "timeouts 3  collisions 0");
         assert_eq!(row_text(&text, ERROR_ROW), "no reply to 0x20");
     }
