@@ -132,16 +132,14 @@ impl Basic {
             self.supervisor.boot(now_us, &self.config);
             self.wifi = io.wifi_store().map(|store| Wifi::start(now_us, store));
             self.dialect.boot(self.config.dialect, io.dialect_store());
-            self.router
-                .set_frame_lengths(self.dialect.get().frame_lengths());
+            self.router.set_dialect(self.dialect.get());
         }
         self.read_bus(now_us, bus);
         self.read_hosts(now_us, hosts, io);
         self.write_wifi_settings(now_us, io);
         let buttons = io.buttons();
         if self.dialect.on_button(now_us, buttons.c) {
-            self.router
-                .set_frame_lengths(self.dialect.get().frame_lengths());
+            self.router.set_dialect(self.dialect.get());
         }
         let quiet = self.forwarder.idle() && !self.router.has_requests();
         if let Some(Err(_)) = self.dialect.save_when_quiet(quiet, io.dialect_store()) {
@@ -248,6 +246,7 @@ impl Basic {
                 for frame in frames.drain(..) {
                     self.on_host_frame(now_us, link, frame, io);
                 }
+                self.router.adopt_dialect(link);
             }
         }
         if self.is_owner(link) {
@@ -262,6 +261,7 @@ impl Basic {
             for frame in frames.drain(..) {
                 self.on_host_frame(now_us, link, frame, io);
             }
+            self.router.adopt_dialect(link);
         }
     }
 
@@ -282,7 +282,7 @@ impl Basic {
             return;
         }
         // The client's dialect ends here: the rest of the Basic, and the Atom, read pymycobot's.
-        let dialect = self.dialect.get();
+        let dialect = self.router.link_dialect(link);
         let dialect::Translated { frame, answer } = dialect.translate(&frame);
         let code = frame.cmd();
         if let Mode::Transparent { .. } = self.mode {
@@ -311,7 +311,7 @@ impl Basic {
             if let Some(new) = answer.new_dialect
                 && self.dialect.set(new)
             {
-                self.router.set_frame_lengths(new.frame_lengths());
+                self.router.set_dialect(new);
             }
             if answer.capture_text {
                 self.router.start_capture(now_us, link);

@@ -3,6 +3,7 @@
 //! gap for truncated frames) and queues bytes for the client without ever blocking the loop.
 
 use heapless::{Deque, Vec};
+use protocol_core::dialect::Dialect;
 use protocol_core::frame::{MAX_FRAME_BYTES, MIN_LEN};
 use protocol_core::listener::{Heard, Listener, ListenerConfig};
 use protocol_core::{Frame, timing};
@@ -94,6 +95,8 @@ pub(crate) type HostFrames = Vec<Frame, MAX_FRAMES_AT_ONCE>;
 pub(crate) struct HostLink {
     kind: LinkKind,
     rx: Listener,
+    /// The dialect its frames are read in ([`Self::adopt`]).
+    dialect: Dialect,
     tx: Deque<u8, HOST_TX_CAPACITY>,
 }
 
@@ -103,6 +106,7 @@ impl HostLink {
         Self {
             kind,
             rx: Listener::new(kind.listener()),
+            dialect: Dialect::Pymycobot,
             tx: Deque::new(),
         }
     }
@@ -131,9 +135,19 @@ impl HostLink {
         self.rx.on_time(now_us, &mut |heard| collect(heard, frames));
     }
 
-    /// Reads LEN as `lengths` says (the clients' dialect), from the next frame on.
-    pub(crate) fn set_frame_lengths(&mut self, lengths: protocol_core::frame::FrameLengths) {
-        self.rx.set_frame_lengths(lengths);
+    /// The dialect this link's frames are read in.
+    pub(crate) fn dialect(&self) -> Dialect {
+        self.dialect
+    }
+
+    /// Reads this link's frames in `dialect` from now on, if no frame is in progress (one
+    /// begun is read whole in the dialect it began in); true if the link speaks `dialect` now.
+    pub(crate) fn adopt(&mut self, dialect: Dialect) -> bool {
+        if self.dialect != dialect && !self.rx.frame_in_progress() {
+            self.dialect = dialect;
+            self.rx.set_frame_lengths(dialect.frame_lengths());
+        }
+        self.dialect == dialect
     }
 
     /// Forgets any partial frame (when the mode changes).

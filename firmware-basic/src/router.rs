@@ -25,8 +25,7 @@
 //! USB one, so a board with one UART passes just that.
 
 use heapless::{Deque, Vec};
-use protocol_core::dialect::Answer;
-use protocol_core::frame::FrameLengths;
+use protocol_core::dialect::{Answer, Dialect};
 use protocol_core::{BytePort, Frame};
 
 use crate::host_link::{HostFrames, HostLink, LinkKind};
@@ -130,8 +129,8 @@ pub(crate) struct Router {
     slots: [Slot; MAX_HOST_LINKS],
     /// The index of the link whose request goes next, if it has one.
     turn: usize,
-    /// How every link reads LEN (the clients' dialect).
-    lengths: FrameLengths,
+    /// The dialect every link is to speak (each adopts it between frames).
+    dialect: Dialect,
 }
 
 impl Router {
@@ -140,16 +139,32 @@ impl Router {
         Self {
             slots: core::array::from_fn(|i| Slot::new(LinkKind::Serial, i == LinkId::USB.index())),
             turn: 0,
-            lengths: FrameLengths::Counted,
+            dialect: Dialect::Pymycobot,
         }
     }
 
-    /// Every link reads LEN as `lengths` says, from its next frame on.
-    pub(crate) fn set_frame_lengths(&mut self, lengths: FrameLengths) {
-        self.lengths = lengths;
+    /// Every link is to speak `dialect`: each adopts it once no frame of its is in progress
+    /// ([`Self::adopt_dialect`]), at once if none is.
+    pub(crate) fn set_dialect(&mut self, dialect: Dialect) {
+        self.dialect = dialect;
         for slot in &mut self.slots {
-            slot.link.set_frame_lengths(lengths);
+            slot.link.adopt(dialect);
         }
+    }
+
+    /// `link` adopts the dialect every link is to speak, if it has no frame in progress.
+    pub(crate) fn adopt_dialect(&mut self, link: LinkId) {
+        let dialect = self.dialect;
+        if let Some(host_link) = self.host_link(link) {
+            host_link.adopt(dialect);
+        }
+    }
+
+    /// The dialect `link`'s frames are read in now.
+    pub(crate) fn link_dialect(&self, link: LinkId) -> Dialect {
+        self.slots
+            .get(link.index())
+            .map_or(self.dialect, |slot| slot.link.dialect())
     }
 
     /// Opens a link for a new client of `kind`.
@@ -161,7 +176,7 @@ impl Router {
             .find(|(_, slot)| !slot.open)
             .ok_or(LinksFull)?;
         slot.restart(kind, true);
-        slot.link.set_frame_lengths(self.lengths);
+        slot.link.adopt(self.dialect);
         LinkId::from_index(index).ok_or(LinksFull)
     }
 
@@ -171,7 +186,7 @@ impl Router {
         if let Some(slot) = self.slots.get_mut(link.index()) {
             let kind = slot.link.kind();
             slot.restart(kind, link == LinkId::USB);
-            slot.link.set_frame_lengths(self.lengths);
+            slot.link.adopt(self.dialect);
         }
     }
 
