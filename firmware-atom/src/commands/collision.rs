@@ -1,0 +1,44 @@
+//! Collision protection: on or off, and each joint's threshold.
+
+use super::*;
+
+/// Answers `request` if it is one of these; gives it back if not.
+pub(super) fn execute<I: AtomIo>(
+    p: &mut Parts,
+    _now_us: u64,
+    request: Request,
+    _link: Link,
+    io: &mut I,
+) -> Result<Answer, Request> {
+    use Request as R;
+    let Parts {
+        settings,
+        flash_writes,
+        ..
+    } = p;
+    Ok(match request {
+        R::SetCollisionMode { on } => {
+            let mut changed = *settings.collision();
+            changed.set_enabled(on);
+            let kept = settings.collision_mut().replace_kept(
+                changed,
+                flash_writes.over(io.param_store()).as_mut().map(as_store),
+            );
+            Answer::Done(kept.map_err(|_| AtomError::Invalid))
+        }
+        R::GetCollisionMode => byte(settings.collision().enabled()),
+        R::SetCollisionThreshold { joint, threshold } => {
+            let mut changed = *settings.collision();
+            if changed.set_threshold(joint.get(), threshold.get()).is_err() {
+                return Ok(Answer::Done(Err(AtomError::Invalid)));
+            }
+            let kept = settings.collision_mut().replace_kept(
+                changed,
+                flash_writes.over(io.param_store()).as_mut().map(as_store),
+            );
+            Answer::Done(kept.map_err(|_| AtomError::Invalid))
+        }
+        R::GetCollisionThresholds => Answer::Now(Reply::Bytes6(settings.collision().thresholds())),
+        other => return Err(other),
+    })
+}

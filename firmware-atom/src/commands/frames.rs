@@ -1,0 +1,46 @@
+//! Coordinate frames: tool, world, reference, movement type, end.
+
+use super::*;
+
+/// Answers `request` if it is one of these; gives it back if not.
+pub(super) fn execute<I: AtomIo>(
+    p: &mut Parts,
+    _now_us: u64,
+    request: Request,
+    _link: Link,
+    _io: &mut I,
+) -> Result<Answer, Request> {
+    use Request as R;
+    let Parts { settings, .. } = p;
+    Ok(match request {
+        R::SetToolReference { pose } => {
+            settings.set_tool(pose);
+            done()
+        }
+        R::GetToolReference => Answer::Now(Reply::Coords(settings.cart().tool())),
+        R::SetWorldReference { pose } => {
+            settings.set_world(pose);
+            done()
+        }
+        R::GetWorldReference => Answer::Now(Reply::Coords(settings.cart().world())),
+        R::SetReferenceFrame { frame } => {
+            settings.set_reference(frame);
+            done()
+        }
+        R::GetReferenceFrame => Answer::Now(Reply::Byte(settings.cart().reference() as u8)),
+        R::SetMovementType { mode } => {
+            settings.set_movement(mode);
+            done()
+        }
+        R::GetMovementType => Answer::Now(Reply::Byte(settings.cart().movement() as u8)),
+        R::SetEndType { end } => {
+            settings.set_end(end);
+            done()
+        }
+        R::GetEndType => Answer::Now(Reply::Byte(match settings.cart().end() {
+            EndType::Flange => 0,
+            EndType::Tool => 1,
+        })),
+        other => return Err(other),
+    })
+}

@@ -1,0 +1,75 @@
+//! System status, power, errors and modes.
+
+use super::*;
+
+/// Answers `request` if it is one of these; gives it back if not.
+pub(super) fn execute<I: AtomIo>(
+    p: &mut Parts,
+    now_us: u64,
+    request: Request,
+    _link: Link,
+    _io: &mut I,
+) -> Result<Answer, Request> {
+    use Request as R;
+    let Parts {
+        settings,
+        bank,
+        motion,
+        errors,
+        ..
+    } = p;
+    Ok(match request {
+        R::GetModifyVersion => Answer::Now(Reply::Byte(MODIFY_VERSION)),
+        R::GetSystemVersion => Answer::Now(Reply::Byte(SYSTEM_VERSION_X10)),
+        R::ClearQueue => {
+            motion.clear_queue();
+            done()
+        }
+        // 1: commands are acknowledged at once and run asynchronously.
+        R::CheckAsyncOrSync => byte(true),
+        R::GetErrorInfo => Answer::Now(Reply::Byte(errors.code())),
+        R::ClearErrorInfo => {
+            errors.clear();
+            done()
+        }
+        R::PowerOn => {
+            settings.set_free_mode(false);
+            if bank.powered() {
+                // Already on (the Basic says so at its boot): a running move goes on.
+                return Ok(done_if(bank.focus_released(settings)));
+            }
+            let ok = bank.power(settings, true);
+            // Hold where the arm is now instead of jumping to an old goal.
+            motion.stop(&mut Context::new(now_us, bank, settings));
+            done_if(ok)
+        }
+        R::PowerOff => {
+            motion.abandon();
+            done_if(bank.power(settings, false))
+        }
+        R::IsPowerOn => byte(bank.powered()),
+        R::ReleaseAllServos { .. } => {
+            motion.abandon();
+            done_if((0..SERVOS).all(|i| bank.set_torque(settings, i, false)))
+        }
+        R::IsControllerConnected => byte(true),
+        R::ReadNextError => Answer::Now(Reply::ServoErrors(core::array::from_fn(|i| {
+            bank.health(i)
+                .map_or(ServoErrorCode::Ok, ServoHealth::error_code)
+                .code()
+        }))),
+        R::SetFreshMode { fresh } => {
+            settings.set_fresh_mode(fresh);
+            done()
+        }
+        R::GetFreshMode => byte(settings.fresh_mode()),
+        R::SetFreeMode { on } => {
+            settings.set_free_mode(on);
+            done()
+        }
+        R::IsFreeMode => byte(settings.free_mode()),
+        R::SetVisionMode { .. } => done(),
+        R::GetRebootCount => Answer::Now(Reply::Int16(0)),
+        other => return Err(other),
+    })
+}
