@@ -10,7 +10,7 @@
 //!   are numbered from 0 where the manual numbers them from 0; 0x26/0x27/0x28 are pause,
 //!   continue, stop; 0x55 sets a servo's zero and 0x56 brakes it; 0x50 checks the connection;
 //!   0x4A/0x4B answer the value alone; the manual's miscounted LENs are read
-//!   ([`FrameLengths::SeedManual`]).
+//!   ([`FrameLengths`](crate::frame::FrameLengths), with the `seed-dialect` feature).
 //!
 //! A dialect is a codec in front of the pymycobot one: [`Dialect::translate`] turns a
 //! request as the client sent it into the pymycobot request that means the same, with the
@@ -20,7 +20,9 @@
 //! dialect, and are answered only if they return a value.
 
 use crate::command::{Reply, ReplyKind, Request};
-use crate::frame::{Frame, FrameLengths};
+use crate::frame::Frame;
+#[cfg(feature = "seed-dialect")]
+use crate::frame::FrameLengths;
 
 /// How a client speaks: see the [module doc](self).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -76,6 +78,7 @@ impl Dialect {
     }
 
     /// How a decoder reads LEN for a client of this dialect.
+    #[cfg(feature = "seed-dialect")]
     pub const fn frame_lengths(self) -> FrameLengths {
         match self {
             Self::Pymycobot => FrameLengths::Counted,
@@ -337,6 +340,7 @@ mod tests {
     }
 
     /// The manual's examples with miscounted LENs, as printed.
+    #[cfg(feature = "seed-dialect")]
     #[test]
     fn seed_lengths_read_the_manuals_miscounted_examples() {
         let examples: [&[u8]; 6] = [
@@ -378,6 +382,7 @@ mod tests {
         }
     }
 
+    #[cfg(feature = "seed-dialect")]
     #[test]
     fn seed_lengths_still_read_the_counted_layouts() {
         let mut d = FrameDecoder::new();

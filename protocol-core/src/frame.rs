@@ -119,12 +119,14 @@ pub enum FrameLengths {
     /// LEN = len(DATA) + 2, always (`protocol.md` section 2).
     #[default]
     Counted,
+    #[cfg(feature = "seed-dialect")]
     /// As [`Counted`](Self::Counted), and the seed manual's miscounted LENs are accepted
     /// where they cannot mean anything else ([`SEED_MISCOUNTS`]): the frame ends at the first
     /// `FA` among the lengths that command really has and the LEN printed.
     SeedManual,
 }
 
+#[cfg(feature = "seed-dialect")]
 /// The LENs the seed manual prints wrong in its request examples (`docs/protocol.md`,
 /// "Dialects"): the command, the LEN as printed, and the data lengths the command really
 /// has. 0x2A and 0x3C print decimal 15 as `0x15`, 0x81 and 0x83 decimal 14 as `0x14`, 0x41 sends
@@ -139,6 +141,7 @@ pub const SEED_MISCOUNTS: [(u8, u8, &[u8]); 6] = [
 ];
 
 /// The data lengths a seed-manual frame with `cmd` and `len` really has, besides LEN's own.
+#[cfg(feature = "seed-dialect")]
 fn seed_miscount(cmd: u8, len: u8) -> Option<&'static [u8]> {
     SEED_MISCOUNTS
         .iter()
@@ -147,8 +150,10 @@ fn seed_miscount(cmd: u8, len: u8) -> Option<&'static [u8]> {
 }
 
 /// Host frames as the seed manual prints them: [`HostFrames`] plus [`SEED_MISCOUNTS`].
+#[cfg(feature = "seed-dialect")]
 struct SeedFrames;
 
+#[cfg(feature = "seed-dialect")]
 impl Format for SeedFrames {
     const HEADER: u8 = HEADER;
 
@@ -274,6 +279,7 @@ impl FrameDecoder {
             FrameLengths::Counted => self
                 .scanner
                 .feed::<HostFrames, _>(bytes, frame_from, on_frame),
+            #[cfg(feature = "seed-dialect")]
             FrameLengths::SeedManual => {
                 self.scanner
                     .feed::<SeedFrames, _>(bytes, frame_from, on_frame);
@@ -285,6 +291,7 @@ impl FrameDecoder {
     pub fn next_frame(&mut self) -> Option<Frame> {
         match self.lengths {
             FrameLengths::Counted => self.scanner.next::<HostFrames, _>(frame_from),
+            #[cfg(feature = "seed-dialect")]
             FrameLengths::SeedManual => self.scanner.next::<SeedFrames, _>(frame_from),
         }
     }

@@ -352,7 +352,7 @@ fn recorded_file_covers_every_command_pymycobot_uses() {
     let codes: std::collections::BTreeSet<u8> = recorded().iter().map(|(b, _)| b[3]).collect();
     // Every modelled command except the ones MyCobot280 4.0.7 has no method for (the older
     // speed commands, MyCobotBasic's PID and arc commands, and the collision settings of
-    // pymycobot's closed-loop arms).
+    // pymycobot's closed-loop arms), and this firmware's own dialect command.
     let not_in_mycobot280 = [
         cmd::GET_SPEED,
         cmd::SET_SPEED,
@@ -365,6 +365,7 @@ fn recorded_file_covers_every_command_pymycobot_uses() {
         cmd::GET_COLLISION_MODE,
         cmd::SET_COLLISION_THRESHOLD,
         cmd::GET_COLLISION_THRESHOLDS,
+        cmd::DIALECT,
     ];
     for code in cmd::ALL {
         if not_in_mycobot280.contains(&code) {

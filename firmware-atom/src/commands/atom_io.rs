@@ -2,14 +2,14 @@
 
 use super::*;
 
-/// Answers `request` if it is one of these; gives it back if not.
+/// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(
     p: &mut Parts,
     now_us: u64,
-    request: Request,
+    request: &Request,
     _link: Link,
     io: &mut I,
-) -> Result<Answer, Request> {
+) -> Option<Answer> {
     use Request as R;
     let Parts {
         settings,
@@ -18,7 +18,7 @@ pub(super) fn execute<I: AtomIo>(
         gripper,
         ..
     } = p;
-    Ok(match request {
+    Some(match *request {
         R::SetPinMode { pin, mode } => {
             let mode = match mode {
                 WirePinMode::Input => PinMode::Input,
@@ -79,6 +79,6 @@ pub(super) fn execute<I: AtomIo>(
             gripper.set_protect_current(current);
             done()
         }
-        other => return Err(other),
+        _ => return None,
     })
 }

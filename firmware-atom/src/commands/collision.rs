@@ -2,21 +2,21 @@
 
 use super::*;
 
-/// Answers `request` if it is one of these; gives it back if not.
+/// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(
     p: &mut Parts,
     _now_us: u64,
-    request: Request,
+    request: &Request,
     _link: Link,
     io: &mut I,
-) -> Result<Answer, Request> {
+) -> Option<Answer> {
     use Request as R;
     let Parts {
         settings,
         flash_writes,
         ..
     } = p;
-    Ok(match request {
+    Some(match *request {
         R::SetCollisionMode { on } => {
             let mut changed = *settings.collision();
             changed.set_enabled(on);
@@ -30,7 +30,7 @@ pub(super) fn execute<I: AtomIo>(
         R::SetCollisionThreshold { joint, threshold } => {
             let mut changed = *settings.collision();
             if changed.set_threshold(joint.get(), threshold.get()).is_err() {
-                return Ok(Answer::Done(Err(AtomError::Invalid)));
+                return Some(Answer::Done(Err(AtomError::Invalid)));
             }
             let kept = settings.collision_mut().replace_kept(
                 changed,
@@ -39,6 +39,6 @@ pub(super) fn execute<I: AtomIo>(
             Answer::Done(kept.map_err(|_| AtomError::Invalid))
         }
         R::GetCollisionThresholds => Answer::Now(Reply::Bytes6(settings.collision().thresholds())),
-        other => return Err(other),
+        _ => return None,
     })
 }

@@ -2,22 +2,22 @@
 
 use super::*;
 
-/// Answers `request` if it is one of these; gives it back if not.
+/// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(
     p: &mut Parts,
     now_us: u64,
-    request: Request,
+    request: &Request,
     _link: Link,
     _io: &mut I,
-) -> Result<Answer, Request> {
+) -> Option<Answer> {
     use Request as R;
     let Parts { drag, .. } = p;
-    Ok(match request {
+    Some(match *request {
         R::DragStartRecord => Answer::Now(Reply::Int16(count(drag.start(now_us)))),
         R::DragEndRecord => Answer::Now(Reply::Int16(count(drag.end()))),
         R::DragGetRecordData => Answer::Now(Reply::DragPoint(drag.next_point())),
         R::DragGetRecordLen => Answer::Now(Reply::Int16(count(drag.recorded()))),
         R::DragClearRecordData => Answer::Now(Reply::Int16(count(drag.clear()))),
-        other => return Err(other),
+        _ => return None,
     })
 }

@@ -2,14 +2,14 @@
 
 use super::*;
 
-/// Answers `request` if it is one of these; gives it back if not.
+/// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(
     p: &mut Parts,
     now_us: u64,
-    request: Request,
+    request: &Request,
     _link: Link,
     _io: &mut I,
-) -> Result<Answer, Request> {
+) -> Option<Answer> {
     use Request as R;
     let Parts {
         settings,
@@ -17,7 +17,7 @@ pub(super) fn execute<I: AtomIo>(
         motion,
         ..
     } = p;
-    Ok(match request {
+    Some(match *request {
         R::SetEncoder {
             servo,
             encoder,
@@ -27,10 +27,10 @@ pub(super) fn execute<I: AtomIo>(
             let index = servo.index();
             let cx = &mut Context::new(now_us, bank, settings);
             if index == GRIPPER {
-                return Ok(Answer::Done(gripper::move_steps(cx, encoder, speed)));
+                return Some(Answer::Done(gripper::move_steps(cx, encoder, speed)));
             }
             if !in_encoder_range(encoder) {
-                return Ok(Answer::Done(Err(AtomError::JointLimit(index))));
+                return Some(Answer::Done(Err(AtomError::JointLimit(index))));
             }
             let target = Target::joint(index, settings.angle(index, encoder), speed);
             Answer::Done(motion.command(cx, Command::Move(target)))
@@ -41,7 +41,7 @@ pub(super) fn execute<I: AtomIo>(
         }
         R::SetEncoders { encoders, speed } => {
             if let Some(j) = encoders.iter().position(|&e| !in_encoder_range(e)) {
-                return Ok(Answer::Done(Err(AtomError::JointLimit(j))));
+                return Some(Answer::Done(Err(AtomError::JointLimit(j))));
             }
             let angles = core::array::from_fn(|j| {
                 Some(settings.angle(j, encoders.get(j).copied().unwrap_or_default()))
@@ -77,6 +77,6 @@ pub(super) fn execute<I: AtomIo>(
         R::SetJointMax { joint, limit } => {
             Answer::Done(settings.set_limit(joint.index(), None, Some(limit)))
         }
-        other => return Err(other),
+        _ => return None,
     })
 }

@@ -2,17 +2,17 @@
 
 use super::*;
 
-/// Answers `request` if it is one of these; gives it back if not.
+/// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(
     p: &mut Parts,
     _now_us: u64,
-    request: Request,
+    request: &Request,
     _link: Link,
     _io: &mut I,
-) -> Result<Answer, Request> {
+) -> Option<Answer> {
     use Request as R;
     let Parts { settings, .. } = p;
-    Ok(match request {
+    Some(match *request {
         R::SetToolReference { pose } => {
             settings.set_tool(pose);
             done()
@@ -41,6 +41,6 @@ pub(super) fn execute<I: AtomIo>(
             EndType::Flange => 0,
             EndType::Tool => 1,
         })),
-        other => return Err(other),
+        _ => return None,
     })
 }

@@ -2,14 +2,14 @@
 
 use super::*;
 
-/// Answers `request` if it is one of these; gives it back if not.
+/// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(
     p: &mut Parts,
     now_us: u64,
-    request: Request,
+    request: &Request,
     _link: Link,
     _io: &mut I,
-) -> Result<Answer, Request> {
+) -> Option<Answer> {
     use Request as R;
     let Parts {
         settings,
@@ -17,7 +17,7 @@ pub(super) fn execute<I: AtomIo>(
         motion,
         ..
     } = p;
-    Ok(match request {
+    Some(match *request {
         R::JogAngle {
             joint,
             direction,
@@ -67,7 +67,7 @@ pub(super) fn execute<I: AtomIo>(
                 .copied()
                 .unwrap_or_default();
             let Ok(goal) = i16::try_from(i32::from(from.0) + i32::from(increment.0)) else {
-                return Ok(Answer::Done(Err(AtomError::JointLimit(j))));
+                return Some(Answer::Done(Err(AtomError::JointLimit(j))));
             };
             let target = Target::joint(j, Centideg(goal), speed.get());
             Answer::Done(motion.command(cx, Command::Move(target)))
@@ -78,7 +78,7 @@ pub(super) fn execute<I: AtomIo>(
             let axis = increment.axis();
             let goal = i32::from(base.get(axis).raw()) + i32::from(increment.raw());
             let Ok(goal) = i16::try_from(goal) else {
-                return Ok(Answer::Done(Err(AtomError::Unreachable)));
+                return Some(Answer::Done(Err(AtomError::Unreachable)));
             };
             let to_pose = Command::ToPose {
                 pose: base.with(protocol_core::command::AxisValue::new(axis, goal)),
@@ -87,6 +87,6 @@ pub(super) fn execute<I: AtomIo>(
             };
             Answer::Done(motion.command(cx, to_pose))
         }
-        other => return Err(other),
+        _ => return None,
     })
 }

@@ -106,7 +106,7 @@ fn as_store<'a>(queued: &'a mut Queued<'_>) -> &'a mut dyn ParamStore {
 }
 
 /// Hands `request` to its family's handler, one module each in `protocol.md` section 5's
-/// order: each answers its own commands and gives the others back. A new command goes into
+/// order: each answers its own commands and nothing else. A new command goes into
 /// its family's `match`.
 fn execute<I: AtomIo>(
     p: &mut Parts,
@@ -120,15 +120,15 @@ fn execute<I: AtomIo>(
         // Both end a collision's refusal of motion (docs/protocol.md section 7).
         p.clear_collision();
     }
-    system::execute(p, now_us, request, link, io)
-        .or_else(|r| motion::execute(p, now_us, r, link, io))
-        .or_else(|r| jog::execute(p, now_us, r, link, io))
-        .or_else(|r| encoders::execute(p, now_us, r, link, io))
-        .or_else(|r| servos::execute(p, now_us, r, link, io))
-        .or_else(|r| collision::execute(p, now_us, r, link, io))
-        .or_else(|r| atom_io::execute(p, now_us, r, link, io))
-        .or_else(|r| drag::execute(p, now_us, r, link, io))
-        .or_else(|r| frames::execute(p, now_us, r, link, io))
+    system::execute(p, now_us, &request, link, io)
+        .or_else(|| motion::execute(p, now_us, &request, link, io))
+        .or_else(|| jog::execute(p, now_us, &request, link, io))
+        .or_else(|| encoders::execute(p, now_us, &request, link, io))
+        .or_else(|| servos::execute(p, now_us, &request, link, io))
+        .or_else(|| collision::execute(p, now_us, &request, link, io))
+        .or_else(|| atom_io::execute(p, now_us, &request, link, io))
+        .or_else(|| drag::execute(p, now_us, &request, link, io))
+        .or_else(|| frames::execute(p, now_us, &request, link, io))
         // What no family takes is the Basic's own (0xA0, 0xA1, 0xB0..0xB2, 0xC0..0xC3, 0xC5),
         // reaching the Atom from a client on its own USB: refused.
         .unwrap_or(Answer::Now(Reply::Byte(0)))

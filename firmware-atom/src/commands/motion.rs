@@ -2,14 +2,14 @@
 
 use super::*;
 
-/// Answers `request` if it is one of these; gives it back if not.
+/// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(
     p: &mut Parts,
     now_us: u64,
-    request: Request,
+    request: &Request,
     link: Link,
     io: &mut I,
-) -> Result<Answer, Request> {
+) -> Option<Answer> {
     use Request as R;
     let Parts {
         settings,
@@ -19,7 +19,7 @@ pub(super) fn execute<I: AtomIo>(
         waiting,
         ..
     } = p;
-    Ok(match request {
+    Some(match *request {
         R::GetAngles => Answer::Now(Reply::Angles(bank.present_angles(now_us, settings))),
         R::SendAngle {
             joint,
@@ -124,6 +124,6 @@ pub(super) fn execute<I: AtomIo>(
         })),
         R::MoveRound => Answer::Done(dispenser.turn(now_us, io)),
         R::SetFourPiecesZero => byte(dispenser.zero(io)),
-        other => return Err(other),
+        _ => return None,
     })
 }

@@ -2,14 +2,14 @@
 
 use super::*;
 
-/// Answers `request` if it is one of these; gives it back if not.
+/// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(
     p: &mut Parts,
     now_us: u64,
-    request: Request,
+    request: &Request,
     _link: Link,
     _io: &mut I,
-) -> Result<Answer, Request> {
+) -> Option<Answer> {
     use Request as R;
     let Parts {
         settings,
@@ -18,7 +18,7 @@ pub(super) fn execute<I: AtomIo>(
         errors,
         ..
     } = p;
-    Ok(match request {
+    Some(match *request {
         R::GetModifyVersion => Answer::Now(Reply::Byte(MODIFY_VERSION)),
         R::GetSystemVersion => Answer::Now(Reply::Byte(SYSTEM_VERSION_X10)),
         R::ClearQueue => {
@@ -36,7 +36,7 @@ pub(super) fn execute<I: AtomIo>(
             settings.set_free_mode(false);
             if bank.powered() {
                 // Already on (the Basic says so at its boot): a running move goes on.
-                return Ok(done_if(bank.focus_released(settings)));
+                return Some(done_if(bank.focus_released(settings)));
             }
             let ok = bank.power(settings, true);
             // Hold where the arm is now instead of jumping to an old goal.
@@ -70,6 +70,6 @@ pub(super) fn execute<I: AtomIo>(
         R::IsFreeMode => byte(settings.free_mode()),
         R::SetVisionMode { .. } => done(),
         R::GetRebootCount => Answer::Now(Reply::Int16(0)),
-        other => return Err(other),
+        _ => return None,
     })
 }
