@@ -488,24 +488,6 @@ const J3: u8 = 2;
 /// The library's `enum Axis`.
 const AXIS_Z: u8 = 2;
 
-/// Runs until the arm stands still, then a little more.
-fn wait_still(robot: &mut VirtualRobot) {
-    robot.run_for(50_000);
-    let still = robot.run_until_true(MOTION_TIMEOUT_US, |r| !r.atom().is_moving());
-    assert!(still, "still moving");
-    robot.run_for(200_000);
-}
-
-/// Runs until the gripper servo stands still.
-fn wait_gripper(robot: &mut VirtualRobot) {
-    robot.run_for(50_000);
-    let still = robot.run_until_true(MOTION_TIMEOUT_US, |r| {
-        r.servo(7).is_some_and(|s| !s.is_moving())
-    });
-    assert!(still, "the gripper never stopped");
-    robot.run_for(100_000);
-}
-
 /// The joints' angles as the servos' shafts are, in degrees.
 fn shafts(robot: &VirtualRobot) -> [f64; 6] {
     robot.shaft_angles_deg()
@@ -941,29 +923,29 @@ fn gripper_calls_move_the_gripper_and_read_it_back() {
     lib::set_gripper_value(&mut robot, 100, 30);
     robot.run_for(20_000);
     assert!(lib::is_gripper_moving(&mut robot));
-    wait_gripper(&mut robot);
+    settle_gripper(&mut robot);
     assert!(!lib::is_gripper_moving(&mut robot));
     assert!(lib::get_gripper_value(&mut robot) >= 98);
     let value = |robot: &VirtualRobot| robot.atom().gripper_value();
 
     // setGripperState(mode, sp): 1 closes, 0 opens.
     lib::set_gripper_state(&mut robot, 1, 80);
-    wait_gripper(&mut robot);
+    settle_gripper(&mut robot);
     assert!(value(&robot) <= 2, "closed: {}", value(&robot));
     assert!(lib::get_gripper_value(&mut robot) <= 2);
     // setGripperState(state, sp, type) and (state, sp, type, is_torque).
     lib::set_gripper_state_typed(&mut robot, 0, 80, 1);
-    wait_gripper(&mut robot);
+    settle_gripper(&mut robot);
     assert!(value(&robot) >= 98, "open: {}", value(&robot));
     lib::set_gripper_state_torque(&mut robot, 1, 80, 1, 0);
-    wait_gripper(&mut robot);
+    settle_gripper(&mut robot);
     assert!(value(&robot) <= 2, "closed: {}", value(&robot));
     // setGripperValue(value, sp, type) and (value, sp, type, is_torque).
     lib::set_gripper_value_typed(&mut robot, 50, 80, 1);
-    wait_gripper(&mut robot);
+    settle_gripper(&mut robot);
     assert!(value(&robot).abs_diff(50) <= 2, "{}", value(&robot));
     lib::set_gripper_value_torque(&mut robot, 30, 80, 1, 1);
-    wait_gripper(&mut robot);
+    settle_gripper(&mut robot);
     assert!(value(&robot).abs_diff(30) <= 2, "{}", value(&robot));
     assert!(lib::get_gripper_value(&mut robot).abs_diff(30) <= 2);
 
