@@ -178,16 +178,6 @@ fn gripper_stop_holds_the_gripper_where_it_is() {
     assert!(after.abs_diff(before) <= 1, "{before} -> {after}");
 }
 
-/// Waits for a gripper command just acknowledged to take effect and the gripper to stop.
-fn settle_gripper(robot: &mut VirtualRobot) {
-    robot.run_for(50_000);
-    let stopped = robot.run_until_true(MOTION_TIMEOUT_US, |r| {
-        r.servo(7).is_some_and(|s| !s.is_moving())
-    });
-    assert!(stopped, "the gripper never stopped");
-    robot.run_for(100_000);
-}
-
 fn release_gripper(robot: &mut VirtualRobot) {
     ack(
         robot,

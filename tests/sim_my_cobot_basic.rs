@@ -58,13 +58,6 @@ fn flange_mm(robot: &VirtualRobot) -> [f64; 3] {
     measure::flange(&robot.shaft_angles_deg()).position_mm
 }
 
-fn wait_still(robot: &mut VirtualRobot) {
-    robot.run_for(50_000);
-    let still = robot.run_until_true(MOTION_TIMEOUT_US, |r| !r.atom().is_moving());
-    assert!(still, "still moving");
-    robot.run_for(200_000);
-}
-
 /// The arm, its joints at some angles away from singularities (writeAngles, 0x22).
 fn posed() -> VirtualRobot {
     let mut robot = arm();

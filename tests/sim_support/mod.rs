@@ -95,6 +95,25 @@ pub fn wait_until_stopped(robot: &mut VirtualRobot) {
     }
 }
 
+/// Watches the arm itself (no request) until it stands still, then 0.2 s more; panics after the
+/// timeout.
+pub fn wait_still(robot: &mut VirtualRobot) {
+    robot.run_for(50_000);
+    let still = robot.run_until_true(MOTION_TIMEOUT_US, |r| !r.atom().is_moving());
+    assert!(still, "still moving");
+    robot.run_for(200_000);
+}
+
+/// Waits for a gripper command just sent to take effect and the gripper to stop.
+pub fn settle_gripper(robot: &mut VirtualRobot) {
+    robot.run_for(50_000);
+    let stopped = robot.run_until_true(MOTION_TIMEOUT_US, |r| {
+        r.servo(7).is_some_and(|s| !s.is_moving())
+    });
+    assert!(stopped, "the gripper never stopped");
+    robot.run_for(100_000);
+}
+
 /// Asserts that `actual` is within [`ANGLE_TOLERANCE`] of `expected`, joint by joint.
 pub fn assert_angles_near(actual: [Centideg; 6], expected: [Centideg; 6], what: &str) {
     for (j, (a, e)) in actual.iter().zip(expected).enumerate() {
