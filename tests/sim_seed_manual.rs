@@ -53,12 +53,6 @@ fn check(robot: &mut VirtualRobot, request: Request) -> Reply {
     ask_on(robot, HostLink::AtomUsb, request)
 }
 
-fn wait_still(robot: &mut VirtualRobot) {
-    robot.run_for(100_000);
-    assert!(robot.run_until_true(MOTION_TIMEOUT_US, |r| !r.atom().is_moving()));
-    robot.run_for(100_000);
-}
-
 fn i16_at(data: &[u8], i: usize) -> i16 {
     i16::from_be_bytes([data[i], data[i + 1]])
 }

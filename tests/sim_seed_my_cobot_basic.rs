@@ -54,8 +54,6 @@
 //! * `ProgramResume` sends 0x28, the manual's stop: a paused move is forgotten, nothing moves;
 //! * `releaseServo` sends 0x56, the manual's brake: the servo stops and keeps its torque; with
 //!   the mode byte (LEN 4) it is no brake frame at all and does nothing;
-//! * `getDigitalInput` (0x62, not in the manual: pymycobot's layout) is answered pin and level
-//!   (LEN 4), where the library parses the level alone (LEN 3) and returns -1;
 //! * `setEletricGripper`, `InitEletricGripper`, `setGripperMode`, `getGripperMode` (0x6B..0x6E)
 //!   and `getServoLastPDI` (0xE6), Pro-350-only calls, are commands this firmware does not
 //!   have: nothing happens and nothing comes back (`getGripperMode` and `getServoLastPDI`
@@ -906,13 +904,13 @@ fn atom_led_and_pins_do_what_the_library_says() {
     let slot = OUTPUT_PINS.iter().position(|&p| p == 22).unwrap();
     assert_eq!(robot.atom_io().pwm[slot], Some((1000, 128)));
 
-    // getDigitalInput (0x62, not in the seed manual) keeps pymycobot's reply, pin and level
-    // (LEN 4): the library parses a LEN-3 reply, the level alone, so it returns -1.
+    // getDigitalInput (0x62, not in the seed manual): the level alone (LEN 3), as the library
+    // parses it.
     lib::set_pin_mode(&mut robot, 19, 0);
     assert!(robot.atom_io_mut().set_input(19, true));
     assert_eq!(
         lib::get_digital_input_reply(&mut robot, 19),
-        [0xFE, 0xFE, 0x04, 0x62, 19, 1, 0xFA]
+        [0xFE, 0xFE, 0x03, 0x62, 1, 0xFA]
     );
 }
 

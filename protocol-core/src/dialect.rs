@@ -9,7 +9,7 @@
 //!   section 3). A command with no return value is not answered; joints, servos and axes
 //!   are numbered from 0 where the manual numbers them from 0; 0x26/0x27/0x28 are pause,
 //!   continue, stop; 0x55 sets a servo's zero and 0x56 brakes it; 0x50 checks the connection;
-//!   0x4A/0x4B answer the value alone; the manual's miscounted LENs are read
+//!   0x4A/0x4B and 0x62 answer the value alone; the manual's miscounted LENs are read
 //!   ([`FrameLengths`](crate::frame::FrameLengths), with the `seed-dialect` feature).
 //!
 //! A dialect is a codec in front of the pymycobot one: [`Dialect::translate`] turns a
@@ -43,7 +43,9 @@ pub enum Answer {
     Silent,
     /// Sent under another CMD, the one the client used (seed 0x50 is pymycobot's 0x14).
     Renamed(u8),
-    /// Sent without its first data byte (seed 0x4A/0x4B: the value without the joint).
+    /// Sent without its first data byte, the number of what was asked (seed 0x4A/0x4B: the
+    /// limit without the joint; 0x62: the level without the pin). A refusal (one byte) is sent
+    /// as it is.
     ValueOnly,
 }
 
@@ -108,7 +110,7 @@ impl Answer {
             Self::Silent => None,
             Self::Renamed(cmd) => Frame::new(cmd, reply.data()),
             Self::ValueOnly => match reply.data() {
-                [_, value @ ..] if value.len() == 2 => Frame::new(reply.cmd(), value),
+                [_, value @ ..] if !value.is_empty() => Frame::new(reply.cmd(), value),
                 _ => Some(reply.clone()),
             },
         }
@@ -206,7 +208,10 @@ mod seed {
         let frame = Frame::new(new_code, &new_data).unwrap_or_default();
         let answer = if !returns_value(&frame) {
             Answer::Silent
-        } else if matches!(new_code, cmd::GET_JOINT_MIN | cmd::GET_JOINT_MAX) {
+        } else if matches!(
+            new_code,
+            cmd::GET_JOINT_MIN | cmd::GET_JOINT_MAX | cmd::GET_DIGITAL_INPUT
+        ) {
             Answer::ValueOnly
         } else {
             Answer::AsIs
@@ -307,6 +312,9 @@ mod tests {
         );
         // A refusal is not cut.
         assert_eq!(a.reply(&frame(0x4A, &[0])), Some(frame(0x4A, &[0])));
+        // MyCobotBasic's getDigitalInput reads the level alone, as that generation answered.
+        let (_, a) = seed(0x62, &[19]);
+        assert_eq!(a.reply(&frame(0x62, &[19, 1])), Some(frame(0x62, &[1])));
     }
 
     #[test]
