@@ -101,11 +101,13 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
         Some(path) => writeln!(out, "basic flash {}", path.display())?,
         None => writeln!(out, "basic flash in memory (no $XDG_STATE_HOME or $HOME)")?,
     }
-    let dialect = match cli.dialect {
-        Some(arg) => Dialect::from(arg),
-        None => flash.load_dialect().ok().flatten().unwrap_or_default(),
-    };
-    writeln!(out, "protocol {} (--dialect)", dialect.name())?;
+    match cli.dialect {
+        Some(arg) => writeln!(out, "protocol {} (--dialect)", Dialect::from(arg).name())?,
+        None => {
+            let stored = flash.load_dialect().ok().flatten().unwrap_or_default();
+            writeln!(out, "protocol {} (the Basic's setting)", stored.name())?;
+        }
+    }
     if let Some(tcp) = &tcp {
         writeln!(out, "tcp on {}", tcp.local_addr()?)?;
     }
