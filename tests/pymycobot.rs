@@ -4,126 +4,18 @@
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
 use std::fs;
-use std::io::Read;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::thread;
-use std::time::{Duration, Instant};
+use std::path::Path;
 
 use nix::sys::signal::Signal;
 
 #[path = "e2e/launcher.rs"]
 mod launcher;
-use launcher::{Launched, launch};
+#[path = "e2e/suite.rs"]
+mod suite;
+use suite::{Robot, run_suite};
 #[path = "e2e/venv.rs"]
 mod venv;
-use venv::{Shown, python, set_up, workspace};
-
-/// The whole Python suite must finish within this (it runs in real time; ~2 min expected).
-const SUITE_DEADLINE: Duration = Duration::from_secs(360);
-
-/// The robot for the suite: a pty link in the temp dir, TCP and the view on free ports.
-struct Robot {
-    launched: Launched,
-    link: PathBuf,
-    tcp: String,
-}
-
-impl Robot {
-    /// A robot of its own named `name` (its pty link and flash file carry the name, so the
-    /// tests of this file, which run at the same time, each talk to their own), with `extra`
-    /// arguments on its command line.
-    fn start(name: &str, extra: &[&str]) -> Robot {
-        let link =
-            std::env::temp_dir().join(format!("open-mycobot-e2e-{}-{name}", std::process::id()));
-        let link_arg = link.to_str().expect("temp dir path is UTF-8");
-        // The Basic's flash (Wi-Fi settings the suite changes) in a scratch file, erased.
-        let flash =
-            Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("e2e-basic-flash-{name}.bin"));
-        let _ = fs::remove_file(&flash);
-        let flash_arg = flash.to_str().expect("target dir path is UTF-8");
-        // The view on too (nobody watches it): the suite runs with the simulation publishing.
-        let mut args = vec![
-            "--pty-link",
-            link_arg,
-            "--tcp",
-            "127.0.0.1:0",
-            "--web",
-            "127.0.0.1:0",
-            "--basic-flash",
-            flash_arg,
-        ];
-        args.extend_from_slice(extra);
-        let launched = launch(&args);
-        let tcp = launched
-            .banner_value("tcp on ")
-            .unwrap_or_else(|| panic!("no TCP address in the banner:\n{}", launched.banner))
-            .to_string();
-        Robot {
-            launched,
-            link,
-            tcp,
-        }
-    }
-}
-
-/// Runs `python -m unittest` on the modules of tests/e2e named like `pattern` (e.g.
-/// `test_*.py`) with a deadline; returns (success, output).
-fn run_suite(python: &Path, robot: &Robot, pattern: &str) -> (bool, String) {
-    let e2e = workspace().join("tests/e2e");
-    let mut child = Command::new(python)
-        .args(["-m", "unittest", "discover", "-v", "-s"])
-        .arg(&e2e)
-        .arg("-t")
-        .arg(&e2e)
-        .args(["-p", pattern])
-        .env("MYCOBOT_PORT", &robot.link)
-        .env("MYCOBOT_TCP", &robot.tcp)
-        // Started just now: its start-up state is checked, not only reset.
-        .env("MYCOBOT_FRESH", "1")
-        .env("PYTHONDONTWRITEBYTECODE", "1")
-        .env("PYTHONWARNINGS", "ignore::DeprecationWarning")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start the Python suite");
-    let mut stdout = child.stdout.take().expect("piped stdout");
-    let mut stderr = child.stderr.take().expect("piped stderr");
-    let out = thread::spawn(move || {
-        let mut s = String::new();
-        let _ = stdout.read_to_string(&mut s);
-        s
-    });
-    let err = thread::spawn(move || {
-        let mut s = String::new();
-        let _ = stderr.read_to_string(&mut s);
-        s
-    });
-    let deadline = Instant::now() + SUITE_DEADLINE;
-    let status = loop {
-        match child.try_wait() {
-            Ok(Some(status)) => break Some(status),
-            Ok(None) if Instant::now() < deadline => thread::sleep(Duration::from_millis(100)),
-            _ => {
-                let _ = child.kill();
-                let _ = child.wait();
-                break None;
-            }
-        }
-    };
-    let output = format!(
-        "{}{}",
-        out.join().unwrap_or_default(),
-        err.join().unwrap_or_default()
-    );
-    match status {
-        Some(status) => (status.success(), output),
-        None => (
-            false,
-            format!("suite killed after {SUITE_DEADLINE:?}\n{output}"),
-        ),
-    }
-}
+use venv::{Shown, python, set_up};
 
 #[test]
 fn pymycobot_end_to_end_suite() {
