@@ -1,6 +1,7 @@
 //! `cargo test --release --test emulated`: the pymycobot 4.0.7 subset (tests/e2e/emulated_subset.py:
-//! status, versions, angle and coordinate moves, jog and stop, IO, bad input, errors) against
-//! the exact board images on emulated chips, started by tools/emulate with Espressif's QEMU:
+//! status, versions, angle and coordinate moves, jog and stop, IO, bad input, errors), then the
+//! seed dialect's (tests/e2e/emulated_seed_subset.py: the manual's frames, raw, after 0xC5
+//! switches the Basic), against the exact board images on emulated chips, started by tools/emulate with Espressif's QEMU:
 //! the ESP32 images when `ESP_QEMU_XTENSA` names its `qemu-system-xtensa`, the ESP32-C3 images
 //! when `ESP_QEMU_RISCV32` names its `qemu-system-riscv32`. Without either it says so in one
 //! line and passes (CI has no emulator). It prints, per image, what passed. The machine is
@@ -89,10 +90,13 @@ impl Drop for Emulated {
     }
 }
 
-/// Runs the subset against `port`; returns whether it passed and unittest's report.
-fn run_subset(python: &PathBuf, port: &PathBuf) -> (bool, String) {
+/// The subsets, one per dialect, in the order they run on the same boards.
+const SUBSETS: [&str; 2] = ["emulated_subset.py", "emulated_seed_subset.py"];
+
+/// Runs `subset` against `port`; returns whether it passed and unittest's report.
+fn run_subset(python: &PathBuf, subset: &str, port: &PathBuf) -> (bool, String) {
     let mut child = Command::new(python)
-        .args(["emulated_subset.py", "-v"])
+        .args([subset, "-v"])
         .current_dir(workspace().join("tests/e2e"))
         .env("MYCOBOT_PORT", port)
         .stdout(Stdio::piped())
@@ -134,27 +138,29 @@ fn pymycobot_subset_on_the_emulated_images() {
     let mut failed = Vec::new();
     for chip in chips {
         let emulated = Emulated::start(chip);
-        let (passed, report) = run_subset(&python, &emulated.link);
+        for subset in SUBSETS {
+            let (passed, report) = run_subset(&python, subset, &emulated.link);
+            say(&format!(
+                "== {chip} images (tools/emulate --chip {chip}), {subset}: {}",
+                if passed { "passed" } else { "FAILED" }
+            ));
+            for line in report.lines().filter(|l| {
+                l.ends_with(" ok")
+                    || l.contains("... FAIL")
+                    || l.contains("... ERROR")
+                    || l.starts_with("AssertionError")
+            }) {
+                say(&format!("   {line}"));
+            }
+            if !passed {
+                say(&report);
+                failed.push(format!("{chip} {subset}"));
+            }
+        }
         drop(emulated);
-        say(&format!(
-            "== {chip} images (tools/emulate --chip {chip}): {}",
-            if passed { "passed" } else { "FAILED" }
-        ));
-        for line in report.lines().filter(|l| {
-            l.ends_with(" ok")
-                || l.contains("... FAIL")
-                || l.contains("... ERROR")
-                || l.starts_with("AssertionError")
-        }) {
-            say(&format!("   {line}"));
-        }
-        if !passed {
-            say(&report);
-            failed.push(chip);
-        }
     }
     assert!(
         failed.is_empty(),
-        "the subset failed on the {failed:?} images"
+        "failed on the emulated images: {failed:?}"
     );
 }
