@@ -82,14 +82,7 @@ fn angle_examples_read_and_move_joint_1_numbered_from_0() {
     let mut robot = seed_arm();
     // Joint 2 out of the way, then the manual's "FE FE 06 21 00 00 00 20 FA": joint_no 0 (the
     // first joint) to 0.00 degrees at speed 0x20.
-    ack_on_atom(
-        &mut robot,
-        Request::SendAngles {
-            angles: degrees([20.0, -10.0, 0.0, 0.0, 0.0, 0.0]),
-            speed: speed(80),
-        },
-    );
-    wait_still(&mut robot);
+    move_on_atom(&mut robot, [20.0, -10.0, 0.0, 0.0, 0.0, 0.0]);
     send_silent(&mut robot, "FE FE 06 21 00 00 00 20 FA");
     wait_still(&mut robot);
     let angles = robot.atom().present_angles();
@@ -144,14 +137,7 @@ fn the_send_angles_example_without_its_speed_byte_is_a_cut_frame() {
 #[test]
 fn coordinate_examples_read_the_pose_move_x_and_reach_the_printed_pose() {
     let mut robot = seed_arm();
-    ack_on_atom(
-        &mut robot,
-        Request::SendAngles {
-            angles: degrees([0.0, -20.0, -60.0, -10.0, 0.0, 0.0]),
-            speed: speed(80),
-        },
-    );
-    wait_still(&mut robot);
+    move_on_atom(&mut robot, [0.0, -20.0, -60.0, -10.0, 0.0, 0.0]);
     let reply = send(&mut robot, "FE FE 02 23 FA").expect("0x23 answers");
     assert_eq!((reply.cmd(), reply.data().len()), (0x23, 12));
     let (x0, y0) = (i16_at(reply.data(), 0), i16_at(reply.data(), 2));
@@ -220,14 +206,7 @@ fn coordinate_examples_read_the_pose_move_x_and_reach_the_printed_pose() {
 #[test]
 fn jog_examples_turn_joint_1_and_move_along_x_until_jog_stop() {
     let mut robot = seed_arm();
-    ack_on_atom(
-        &mut robot,
-        Request::SendAngles {
-            angles: degrees([0.0, -20.0, -60.0, -10.0, 0.0, 0.0]),
-            speed: speed(80),
-        },
-    );
-    wait_still(&mut robot);
+    move_on_atom(&mut robot, [0.0, -20.0, -60.0, -10.0, 0.0, 0.0]);
     // "FE FE 05 30 01 01 32 FA": joint 1 (numbered from 1 here), direction 1, 50 %.
     let j1 = robot.atom().present_angles()[0];
     send_silent(&mut robot, "FE FE 05 30 01 01 32 FA");
@@ -299,14 +278,7 @@ fn joint_limit_examples_answer_the_value_alone_and_narrow_joint_1() {
     // rule; the caption says 90). Then "FE FE 05 4C 00 01 44 FA" raises its minimum there.
     send_silent(&mut robot, "FE FE 05 4D 00 01 44 FA");
     assert_eq!(robot.atom().joint_limits()[0].max, Centideg(3240));
-    ack_on_atom(
-        &mut robot,
-        Request::SendAngles {
-            angles: degrees([32.4, 0.0, 0.0, 0.0, 0.0, 0.0]),
-            speed: speed(80),
-        },
-    );
-    wait_still(&mut robot);
+    move_on_atom(&mut robot, [32.4, 0.0, 0.0, 0.0, 0.0, 0.0]);
     send_silent(&mut robot, "FE FE 05 4C 00 01 44 FA");
     assert_eq!(robot.atom().joint_limits()[0].min, Centideg(3240));
 }
@@ -335,14 +307,7 @@ fn servo_examples_check_the_connection_and_the_servos() {
     robot.run_for(50_000);
     assert!(robot.servo(1).unwrap().torque_enabled());
     // "FE FE 03 55 00 FA": servo 1's present position becomes its zero (2048).
-    ack_on_atom(
-        &mut robot,
-        Request::SendAngles {
-            angles: degrees([10.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
-            speed: speed(80),
-        },
-    );
-    wait_still(&mut robot);
+    move_on_atom(&mut robot, [10.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
     send_silent(&mut robot, "FE FE 03 55 00 FA");
     robot.run_for(200_000);
     let s1 = robot.servo(1).unwrap().present_position();
@@ -352,14 +317,7 @@ fn servo_examples_check_the_connection_and_the_servos() {
 #[test]
 fn pause_continue_and_stop_are_0x26_0x27_0x28() {
     let mut robot = seed_arm();
-    ack_on_atom(
-        &mut robot,
-        Request::SendAngles {
-            angles: degrees([0.0; 6]),
-            speed: speed(80),
-        },
-    );
-    wait_still(&mut robot);
+    move_on_atom(&mut robot, [0.0; 6]);
     let far = "FE FE 06 21 00 2E E0 0A FA"; // joint 1 to 120 degrees, slowly
     send_silent(&mut robot, far);
     robot.run_for(400_000);
@@ -430,6 +388,19 @@ fn frame_examples_set_and_read_the_tool_world_reference_and_end() {
     assert_eq!(send(&mut robot, "FE FE 02 8A FA").unwrap().data(), [1]);
     send_silent(&mut robot, "FE FE 03 89 00 FA");
     assert_eq!(send(&mut robot, "FE FE 02 8A FA").unwrap().data(), [0]);
+}
+
+/// Moves the joints to `angles` (degrees) in pymycobot's dialect on the Atom's own port, and
+/// waits until the arm is still.
+fn move_on_atom(robot: &mut VirtualRobot, angles: [f64; 6]) {
+    ack_on_atom(
+        robot,
+        Request::SendAngles {
+            angles: degrees(angles),
+            speed: speed(80),
+        },
+    );
+    wait_still(robot);
 }
 
 /// Asks in pymycobot's dialect on the Atom's own port and checks it is taken.

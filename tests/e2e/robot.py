@@ -23,6 +23,8 @@ import unittest
 
 from pymycobot import MyCobot280
 
+from patience import PATIENCE, wait_until  # noqa: F401 (the tests import both from here)
+
 PORT = os.environ.get("MYCOBOT_PORT", "/tmp/mycobot")
 FRESH = os.environ.get("MYCOBOT_FRESH") == "1"
 
@@ -39,12 +41,6 @@ ROT_TOL_DEG = 0.2
 MOVE_TIMEOUT = 6.0
 # Longest the reset's move home may take (s): from anywhere in the factory range at speed 100.
 HOME_TIMEOUT = 15.0
-# Every wait for something the arm does gives up only after PATIENCE times its timeout, the
-# time it takes on an idle machine with room. On a busy machine the robot runs late (it stalls
-# while other programs have the cores; docs/quickstart.md), and a wait that gives up then
-# fails a test of behaviour on the machine's load. A passing wait ends as soon as the arm is
-# there: the patience only costs time when a test fails anyway.
-PATIENCE = 5
 
 _arm = None
 # What the robot reported when this suite first connected, before the reset:
@@ -154,17 +150,6 @@ def frame(cmd, *data):
 def i16(value):
     """A big-endian int16 as two bytes."""
     return list(struct.pack(">h", value))
-
-
-def wait_until(predicate, timeout, interval=0.02):
-    """Polls predicate() until it returns a truthy value, for up to `timeout` s on an idle
-    machine (PATIENCE times that on a busy one); returns it, or the last value."""
-    deadline = time.monotonic() + timeout * PATIENCE
-    value = predicate()
-    while not value and time.monotonic() < deadline:
-        time.sleep(interval)
-        value = predicate()
-    return value
 
 
 # ---------------------------------------------------------------- f64 kinematics reference

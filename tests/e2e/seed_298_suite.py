@@ -51,6 +51,8 @@ import unittest
 import pymycobot
 from pymycobot.mycobot import MyCobot
 
+from patience import PATIENCE, wait_until
+
 if pymycobot.__version__ != "2.9.8":
     raise ImportError(f"this suite is for pymycobot 2.9.8, not {pymycobot.__version__}")
 
@@ -64,7 +66,6 @@ ANGLE_TOL = 0.2
 POS_TOL_MM = 1.0
 ROT_TOL_DEG = 0.5
 MOVE_TIMEOUT = 6.0
-PATIENCE = 5
 # How long 2.9.8's read waits for a reply (common.read's wait_time).
 READ_WINDOW = 0.1
 # How long the line must stay quiet before a late reply counts as drained, how long a late
@@ -149,17 +150,6 @@ def tell(name, *args):
     value = getattr(mc(), name)(*args)
     if value is not None:
         raise AssertionError(f"{name}{args} returned {value!r}: 2.9.8 returns None")
-
-
-def wait_until(predicate, timeout, interval=0.02):
-    """Polls predicate() until it returns a truthy value, for up to `timeout` s on an idle
-    machine (PATIENCE times that on a busy one); returns it, or the last value."""
-    deadline = time.monotonic() + timeout * PATIENCE
-    value = predicate()
-    while not value and time.monotonic() < deadline:
-        time.sleep(interval)
-        value = predicate()
-    return value
 
 
 def near(actual, expected, tol=ANGLE_TOL):
