@@ -19,20 +19,11 @@
 //! Commands the manual does not list keep their pymycobot layout and numbering in the seed
 //! dialect, and are answered only if they return a value.
 
+pub use crate::command::Dialect;
 use crate::command::{Reply, ReplyKind, Request};
 use crate::frame::Frame;
 #[cfg(feature = "seed-dialect")]
 use crate::frame::FrameLengths;
-
-/// How a client speaks: see the [module doc](self).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Dialect {
-    /// pymycobot's protocol: every command answered, joints numbered from 1.
-    #[default]
-    Pymycobot = 1,
-    /// The vendor manual's protocol: set commands unanswered, numbering from 0.
-    Seed = 2,
-}
 
 /// What becomes of the pymycobot reply to a translated request.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -59,26 +50,6 @@ pub struct Translated {
 }
 
 impl Dialect {
-    /// Both dialects, the default first.
-    pub const ALL: [Self; 2] = [Self::Pymycobot, Self::Seed];
-
-    /// The dialect for wire byte `v` (0xC5's data): 1 pymycobot, 2 seed.
-    pub const fn from_u8(v: u8) -> Option<Self> {
-        match v {
-            1 => Some(Self::Pymycobot),
-            2 => Some(Self::Seed),
-            _ => None,
-        }
-    }
-
-    /// Its name, as the screen, the 3D view and the command line show it.
-    pub const fn name(self) -> &'static str {
-        match self {
-            Self::Pymycobot => "pymycobot",
-            Self::Seed => "seed",
-        }
-    }
-
     /// How a decoder reads LEN for a client of this dialect.
     #[cfg(feature = "seed-dialect")]
     pub const fn frame_lengths(self) -> FrameLengths {

@@ -1,6 +1,16 @@
 //! The Atom's pins, its LEDs and the gripper.
 
-use super::*;
+use protocol_core::command::{PinMode as WirePinMode, Reply, Request};
+
+use crate::config::GRIPPER;
+use crate::context::Context;
+use crate::error::AtomError;
+use crate::io::{AtomIo, PinMode, is_output_pin, mode_allowed};
+use crate::link::Link;
+use crate::parts::Parts;
+use crate::registers;
+
+use super::answer::{Answer, byte, done, done_if};
 
 /// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(

@@ -1,6 +1,13 @@
 //! Collision protection: on or off, and each joint's threshold.
 
-use super::*;
+use protocol_core::command::{Reply, Request};
+
+use crate::error::AtomError;
+use crate::io::AtomIo;
+use crate::link::Link;
+use crate::parts::Parts;
+
+use super::answer::{Answer, as_store, byte};
 
 /// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(

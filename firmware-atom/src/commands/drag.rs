@@ -1,6 +1,12 @@
 //! Drag teaching: recording the arm moved by hand, and reading it back.
 
-use super::*;
+use protocol_core::command::{Reply, Request};
+
+use crate::io::AtomIo;
+use crate::link::Link;
+use crate::parts::Parts;
+
+use super::answer::{Answer, count};
 
 /// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(

@@ -1,6 +1,18 @@
 //! Encoder goals and reads, the default speed, joint limits.
 
-use super::*;
+use protocol_core::command::{Reply, Request};
+use protocol_core::units::Decideg;
+
+use crate::config::{GRIPPER, in_encoder_range};
+use crate::context::Context;
+use crate::error::AtomError;
+use crate::io::AtomIo;
+use crate::link::Link;
+use crate::motion::{Command, Target};
+use crate::parts::Parts;
+use crate::{gripper, registers};
+
+use super::answer::{Answer, done};
 
 /// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(

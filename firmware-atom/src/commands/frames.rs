@@ -1,6 +1,12 @@
 //! Coordinate frames: tool, world, reference, movement type, end.
 
-use super::*;
+use protocol_core::command::{EndType, Reply, Request};
+
+use crate::io::AtomIo;
+use crate::link::Link;
+use crate::parts::Parts;
+
+use super::answer::{Answer, done};
 
 /// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(

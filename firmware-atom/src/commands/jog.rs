@@ -1,6 +1,16 @@
 //! Jogs: a joint or an axis until jog stop, and increments.
 
-use super::*;
+use protocol_core::command::{MoveMode, Request};
+use protocol_core::units::Centideg;
+
+use crate::context::Context;
+use crate::error::AtomError;
+use crate::io::AtomIo;
+use crate::link::Link;
+use crate::motion::{Command, Target};
+use crate::parts::Parts;
+
+use super::answer::{Answer, dir};
 
 /// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(

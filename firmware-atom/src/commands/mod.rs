@@ -8,32 +8,22 @@
 //! 0x07. A frame that is not a valid command (unknown code, wrong length, field out of range)
 //! answers `00` too, so the client never waits for a reply that will not come.
 //!
-//! The commands come in families, a module each, readable one at a time: [`system`] (status,
+//! The commands come in families, a module each, readable one at a time (what they share, the
+//! [`answer`] a request produces, in its own): [`system`] (status,
 //! power, errors, modes), [`motion`], [`jog`], [`encoders`] (with speed and limits),
 //! [`servos`], [`collision`], [`atom_io`] (pins, LEDs, gripper), [`drag`] (teaching) and
 //! [`frames`] (coordinate frames).
 
 use protocol_core::Frame;
-use protocol_core::command::{
-    DataWidth, Direction, EndType, MoveMode, PinMode as WirePinMode, Reply, Request,
-    ServoErrorCode, ServoSelect, cmd,
-};
-use protocol_core::units::{Centideg, Decideg};
+use protocol_core::command::{Reply, Request, cmd};
 
-use crate::cartesian::for_client;
-use crate::config::{GRIPPER, JOINTS, SERVOS, in_encoder_range};
-use crate::context::Context;
-use crate::error::AtomError;
-use crate::flash_writes::Queued;
-use crate::health::ServoHealth;
-use crate::io::{AtomIo, PinMode, is_output_pin, mode_allowed};
+use crate::io::AtomIo;
 use crate::link::Link;
-use crate::motion::{Command, JogDirection, Target};
 use crate::parts::Parts;
-use crate::store::ParamStore;
-use crate::waiting::WaitingRead;
-use crate::{backup, gains, gripper, registers};
 
+use answer::Answer;
+
+mod answer;
 mod atom_io;
 mod collision;
 mod drag;
@@ -43,11 +33,6 @@ mod jog;
 mod motion;
 mod servos;
 mod system;
-
-/// Reported by get system version (0x02): 7.0, the vendor's 280 M5 generation.
-const SYSTEM_VERSION_X10: u8 = 70;
-/// Reported by get modify version (0x01).
-const MODIFY_VERSION: u8 = 0;
 
 /// Handles one request; returns the reply (none only when the reply waits for the bus).
 pub(crate) fn handle<I: AtomIo>(
@@ -78,33 +63,6 @@ pub(crate) fn handle<I: AtomIo>(
     Some(reply.to_frame(code))
 }
 
-/// What a request produced.
-enum Answer {
-    /// This reply.
-    Now(Reply),
-    /// The reply follows when a servo transaction finishes.
-    Later,
-    /// A set command: ack or refusal.
-    Done(Result<(), AtomError>),
-}
-
-fn byte(v: bool) -> Answer {
-    Answer::Now(Reply::Byte(u8::from(v)))
-}
-
-fn done_if(ok: bool) -> Answer {
-    Answer::Done(if ok { Ok(()) } else { Err(AtomError::Invalid) })
-}
-
-fn done() -> Answer {
-    Answer::Done(Ok(()))
-}
-
-/// The flash seen through the records waiting for it, as the parts take a store.
-fn as_store<'a>(queued: &'a mut Queued<'_>) -> &'a mut dyn ParamStore {
-    queued
-}
-
 /// Hands `request` to its family's handler, one module each in `protocol.md` section 5's
 /// order: each answers its own commands and nothing else. A new command goes into
 /// its family's `match`.
@@ -132,26 +90,6 @@ fn execute<I: AtomIo>(
         // What no family takes is the Basic's own (0xA0, 0xA1, 0xB0..0xB2, 0xC0..0xC3, 0xC5),
         // reaching the Atom from a client on its own USB: refused.
         .unwrap_or(Answer::Now(Reply::Byte(0)))
-}
-
-/// A request whose reply waits for servo reads: later if they were queued, refused if not.
-fn later(queued: Result<(), AtomError>) -> Answer {
-    match queued {
-        Ok(()) => Answer::Later,
-        Err(e) => Answer::Done(Err(e)),
-    }
-}
-
-/// A count of drag-teaching points as the int16 the host reads (at most 1 000).
-fn count(n: u16) -> i16 {
-    i16::try_from(n).unwrap_or(i16::MAX)
-}
-
-fn dir(d: Direction) -> JogDirection {
-    match d {
-        Direction::Negative => JogDirection::Negative,
-        Direction::Positive => JogDirection::Positive,
-    }
 }
 
 #[cfg(test)]

@@ -1,6 +1,17 @@
 //! Moves: angles, poses, lines, arcs, pause, stop, and the questions about them.
 
-use super::*;
+use protocol_core::command::{Reply, Request};
+
+use crate::cartesian::for_client;
+use crate::context::Context;
+use crate::gains;
+use crate::io::AtomIo;
+use crate::link::Link;
+use crate::motion::{Command, Target};
+use crate::parts::Parts;
+use crate::waiting::WaitingRead;
+
+use super::answer::{Answer, byte, done, later};
 
 /// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(

@@ -1,6 +1,17 @@
 //! One servo at a time: torque, brake, calibration, registers, health, backups.
 
-use super::*;
+use protocol_core::command::{DataWidth, Reply, Request, ServoSelect};
+
+use crate::config::{JOINTS, SERVOS};
+use crate::context::Context;
+use crate::health::ServoHealth;
+use crate::io::AtomIo;
+use crate::link::Link;
+use crate::parts::Parts;
+use crate::waiting::WaitingRead;
+use crate::{backup, registers};
+
+use super::answer::{Answer, byte, done_if, later};
 
 /// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(

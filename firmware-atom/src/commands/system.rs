@@ -1,6 +1,20 @@
 //! System status, power, errors and modes.
 
-use super::*;
+use protocol_core::command::{Reply, Request, ServoErrorCode};
+
+use crate::config::SERVOS;
+use crate::context::Context;
+use crate::health::ServoHealth;
+use crate::io::AtomIo;
+use crate::link::Link;
+use crate::parts::Parts;
+
+use super::answer::{Answer, byte, done, done_if};
+
+/// Reported by get system version (0x02): 7.0, the vendor's 280 M5 generation.
+const SYSTEM_VERSION_X10: u8 = 70;
+/// Reported by get modify version (0x01).
+const MODIFY_VERSION: u8 = 0;
 
 /// Answers `request` if it is one of these; `None` if not.
 pub(super) fn execute<I: AtomIo>(

@@ -48,9 +48,9 @@ pub use reply::{DragPoint, Reply, ReplyError, ReplyKind};
 pub use request::{MAX_DRAG_SPEED, Request, RequestKind};
 pub use types::{
     AtomPin, Axis, AxisValue, BasicInputPin, BasicOutputPin, CollisionThreshold, DataWidth,
-    Direction, EndType, GripperModel, GripperSpeed, GripperState, GripperType, GripperValue,
-    JointId, MoveMode, PinMode, Pose, PositionTarget, ReferenceFrame, Rgb, RpyAxis, ServoId,
-    ServoSelect, ServoValue, TransponderMode,
+    Dialect, Direction, EndType, GripperModel, GripperSpeed, GripperState, GripperType,
+    GripperValue, JointId, MoveMode, PinMode, Pose, PositionTarget, ReferenceFrame, Rgb, RpyAxis,
+    ServoId, ServoSelect, ServoValue, TransponderMode,
 };
 
 /// True for the commands the Basic answers itself and never forwards to the Atom: its own IO

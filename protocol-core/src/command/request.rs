@@ -15,9 +15,9 @@ use super::error::CommandError;
 use super::reply::ReplyKind;
 use super::types::{
     AtomPin, Axis, AxisValue, BasicInputPin, BasicOutputPin, CollisionThreshold, DataWidth,
-    Direction, EndType, GripperModel, GripperSpeed, GripperState, GripperType, GripperValue,
-    JointId, MoveMode, PinMode, Pose, PositionTarget, ReferenceFrame, Rgb, RpyAxis, ServoId,
-    ServoSelect, ServoValue, TransponderMode,
+    Dialect, Direction, EndType, GripperModel, GripperSpeed, GripperState, GripperType,
+    GripperValue, JointId, MoveMode, PinMode, Pose, PositionTarget, ReferenceFrame, Rgb, RpyAxis,
+    ServoId, ServoSelect, ServoValue, TransponderMode,
 };
 use super::wire::Writer;
 
@@ -821,10 +821,10 @@ requests! {
         /// the dialect in force.
         Dialect {
             /// The dialect to switch to; `None` asks.
-            set: Option<crate::dialect::Dialect>,
+            set: Option<Dialect>,
         } = cmd::DIALECT, reply ReplyKind::Byte,
         data 0 | 1 => |f| Self::Dialect {
-            set: f.optional(|f| f.enum_byte(crate::dialect::Dialect::from_u8))?,
+            set: f.optional(|f| f.enum_byte(Dialect::from_u8))?,
         },
         emit |w| {
             if let Some(d) = set {

@@ -573,3 +573,36 @@ pub struct Rgb {
     /// Blue, 0..=255.
     pub b: u8,
 }
+
+/// How a client speaks the host protocol: pymycobot's dialect or the vendor manual's
+/// ([`crate::dialect`], `docs/protocol.md` section 21).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Dialect {
+    /// pymycobot's protocol: every command answered, joints numbered from 1.
+    #[default]
+    Pymycobot = 1,
+    /// The vendor manual's protocol: set commands unanswered, numbering from 0.
+    Seed = 2,
+}
+
+impl Dialect {
+    /// Both dialects, the default first.
+    pub const ALL: [Self; 2] = [Self::Pymycobot, Self::Seed];
+
+    /// The dialect for wire byte `v` (0xC5's data): 1 pymycobot, 2 seed.
+    pub const fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            1 => Some(Self::Pymycobot),
+            2 => Some(Self::Seed),
+            _ => None,
+        }
+    }
+
+    /// Its name, as the screen, the 3D view and the command line show it.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Pymycobot => "pymycobot",
+            Self::Seed => "seed",
+        }
+    }
+}
