@@ -375,9 +375,15 @@ impl Basic {
         {
             let answer = match change {
                 SettingsChange::Frame(frame) => {
-                    let dialect = self.dialect.get().translate(&frame).answer;
+                    // 0xB0 and 0xB2 are the same frame in both dialects; whether the client
+                    // gets an answer is its dialect's to say.
+                    let wanted = self
+                        .router
+                        .link_dialect(client.link)
+                        .translate(&frame)
+                        .answer;
                     local::answer(&frame, io, self.local_context(now_us))
-                        .map(|a| a.in_dialect(dialect))
+                        .map(|a| a.in_dialect(wanted))
                 }
                 SettingsChange::Text(end) => {
                     local::answer_set_text(end, io, self.wifi.as_mut(), now_us)

@@ -22,11 +22,11 @@
 use heapless::Vec;
 use protocol_core::Frame;
 use protocol_core::command::{CommandError, Reply, Request, cmd, is_basic_local};
+use protocol_core::dialect::{Answer, Dialect};
 
 use crate::io::BasicIo;
 use crate::status::{BasicError, TransponderMode};
 use crate::wifi::{MAX_GET_TEXT, SetTextEnd, Wifi, WifiAnswer, WifiReply};
-use protocol_core::dialect::{Answer, Dialect};
 
 /// What 0xB1 answers on a board without Wi-Fi: no network configured, in the text form
 /// pymycobot parses.
@@ -262,6 +262,34 @@ mod tests {
             AnswerBody::Text(bytes) => bytes.to_vec(),
             AnswerBody::Nothing => std::vec::Vec::new(),
         }
+    }
+
+    #[test]
+    fn the_dialect_command_names_the_dialect_in_force_after_it() {
+        let mut io = FakeIo::default();
+        let asked = ask(&mut io, cmd::DIALECT, &[]).unwrap();
+        assert_eq!(reply_bytes(&asked), [0xFE, 0xFE, 0x03, 0xC5, 0x01, 0xFA]);
+        assert_eq!(asked.new_dialect, None);
+        let set = ask(&mut io, cmd::DIALECT, &[2]).unwrap();
+        assert_eq!(reply_bytes(&set), [0xFE, 0xFE, 0x03, 0xC5, 0x02, 0xFA]);
+        assert_eq!(set.new_dialect, Some(Dialect::Seed));
+        let refused = ask(&mut io, cmd::DIALECT, &[7]).unwrap();
+        assert_eq!(reply_bytes(&refused), [0xFE, 0xFE, 0x03, 0xC5, 0x00, 0xFA]);
+        assert_eq!(refused.new_dialect, None);
+    }
+
+    #[test]
+    fn a_seed_client_gets_no_answer_to_a_set_command_and_the_value_of_a_query() {
+        let mut io = FakeIo::default();
+        let set = ask(&mut io, 0xA0, &[5, 1])
+            .unwrap()
+            .in_dialect(Answer::Silent);
+        assert_eq!(set.body, AnswerBody::Nothing);
+        assert_eq!(io.outputs, [(5, true)], "done all the same");
+        let query = ask(&mut io, cmd::DIALECT, &[])
+            .unwrap()
+            .in_dialect(Answer::AsIs);
+        assert_eq!(reply_bytes(&query), [0xFE, 0xFE, 0x03, 0xC5, 0x01, 0xFA]);
     }
 
     #[test]
