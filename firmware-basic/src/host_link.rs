@@ -309,6 +309,26 @@ mod tests {
     }
 
     #[test]
+    fn a_new_dialect_is_adopted_between_frames_only() {
+        // The manual's set speed with its LEN miscounted (02 for one data byte).
+        let seed_set_speed = [0xFE, 0xFE, 0x02, 0x41, 0x32, 0xFA];
+        let mut link = HostLink::new(LinkKind::Serial);
+        assert!(
+            hear_all(&mut link, 0, &seed_set_speed).is_empty(),
+            "pymycobot's LEN"
+        );
+        let mut link = HostLink::new(LinkKind::Serial);
+        let (first, rest) = GET_ANGLES.split_at(3);
+        assert!(hear_all(&mut link, 0, first).is_empty());
+        assert!(!link.adopt(Dialect::Seed), "a frame is in progress");
+        assert_eq!(hear_all(&mut link, 300, rest).len(), 1);
+        assert!(link.adopt(Dialect::Seed));
+        assert_eq!(link.dialect(), Dialect::Seed);
+        let heard = hear_all(&mut link, 1_000, &seed_set_speed);
+        assert_eq!(heard.first().map(Frame::data), Some(&[0x32][..]));
+    }
+
+    #[test]
     fn replies_are_queued_whole_or_not_at_all() {
         let mut link = HostLink::new(LinkKind::Serial);
         let filler = [0x55; HOST_TX_CAPACITY - MAX_FRAME_BYTES + 1];
