@@ -223,6 +223,15 @@ fn the_page_draws_the_arm_and_shows_it_move() {
         .evaluate(&page, "document.getElementById('led').textContent")
         .expect("evaluate");
     assert_eq!(led, "#00c8ff", "the LED colour set with set_color");
+    let status = browser
+        .evaluate(&page, "document.getElementById('status').textContent")
+        .expect("evaluate");
+    assert!(
+        status
+            .as_str()
+            .is_some_and(|s| s.contains("pymycobot protocol")),
+        "the status line names the Basic's dialect: {status}"
+    );
 
     // ...and it drew the flange where kinematics-core puts it for the angles it shows.
     let (shown, drawn) = {
