@@ -91,6 +91,18 @@ fn the_start_up_line_names_the_board_whose_port_is_served() {
 }
 
 #[test]
+fn the_seed_dialect_on_the_atoms_own_port_is_refused_with_one_line() {
+    let out = run_to_end(&["--port", "atom-usb", "--dialect", "seed", "--no-web"]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("the Atom's own port speaks pymycobot's"),
+        "{stderr}"
+    );
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+}
+
+#[test]
 fn refuses_to_replace_a_regular_file_with_the_link() {
     let dir = scratch("file");
     let notes = dir.join("notes.txt");
