@@ -185,8 +185,8 @@ impl<P: BytePort, C: Clock> MyCobot<P, C> {
 
     // --- 2.4 jog mode ---
 
-    /// jogAngle (manual 2.4): one joint turning in `direction` until [`jog_stop`]
-    /// (Self::jog_stop), [`stop`](Self::stop) or its limit (0x30).
+    /// jogAngle (manual 2.4): one joint turning in `direction` until
+    /// [`jog_stop`](Self::jog_stop), [`stop`](Self::stop) or its limit (0x30).
     pub fn jog_angle(
         &mut self,
         joint: JointId,
