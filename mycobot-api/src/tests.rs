@@ -748,3 +748,36 @@ fn the_error_lines_name_the_command_and_the_reason() {
     );
     assert_eq!(refused.cmd(), 0x25);
 }
+
+#[test]
+fn any_request_goes_through_request() {
+    use protocol_core::command::{Reply, Request};
+    let pin = AtomPin::new(19).unwrap();
+    let level = Request::GetDigitalInput { pin };
+    // The seed dialect answers the level alone; the reply names the pin again.
+    let (mut arm, _) = bot(Dialect::Seed, std::vec![frame(0x62, &[1])]);
+    let high = Reply::PinLevel {
+        pin: 19,
+        high: true,
+    };
+    assert_eq!(arm.request(&level), Ok(Some(high.clone())));
+    assert_eq!(arm.port().written, [hex("FE FE 03 62 13 FA")]);
+    let (mut arm, _) = bot(Dialect::Seed, std::vec![frame(0x62, &[5])]);
+    assert_eq!(arm.request(&level), Err(Error::BadReply { cmd: 0x62 }));
+    let (mut arm, _) = bot(Dialect::Pymycobot, std::vec![frame(0x62, &[19, 1])]);
+    assert_eq!(arm.request(&level), Ok(Some(high)));
+    // A command the typed calls do not cover, and one without a value in seed.
+    let (mut arm, _) = bot(Dialect::Pymycobot, std::vec![frame(0x17, &[1])]);
+    assert_eq!(
+        arm.request(&Request::GetFreshMode),
+        Ok(Some(Reply::Byte(1)))
+    );
+    let (mut arm, _) = bot(Dialect::Seed, std::vec![]);
+    let fresh = Request::SetFreshMode { fresh: false };
+    assert_eq!(arm.request(&fresh), Ok(None));
+    assert_eq!(arm.port().written, [hex("FE FE 03 16 00 FA")]);
+    assert_eq!(
+        arm.request(&Request::IsPaused),
+        Err(Error::NotInDialect { cmd: 0x27 })
+    );
+}
