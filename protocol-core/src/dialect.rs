@@ -15,6 +15,8 @@
 //! A dialect is a codec in front of the pymycobot one: [`Dialect::translate`] turns a
 //! request as the client sent it into the pymycobot request that means the same, with the
 //! [`Answer`] that turns the pymycobot reply into what the client expects (or into nothing).
+//! [`Dialect::encode`] goes the other way, for a client: the frame of its dialect that
+//! translates into a given request.
 //! Whatever is not protocol (limits, safety, motion, several clients) is the same in both.
 //! Commands the manual does not list keep their pymycobot layout and numbering in the seed
 //! dialect, and are answered only if they return a value.
@@ -71,6 +73,20 @@ impl Dialect {
             Self::Seed => seed::translate(request),
         }
     }
+
+    /// The frame a client of this dialect sends to mean `request`: the inverse of
+    /// [`Dialect::translate`], so `translate(&encode(r)?).frame` parses as `r`. In
+    /// [`Dialect::Pymycobot`] always [`Request::to_frame`]; in [`Dialect::Seed`] the frame the
+    /// manual prints (joints, servos and axes numbered from 0 where it numbers them so, 0x27
+    /// continue, 0x28 stop, 0x55 zero, 0x56 brake, 0x2A a pose), or `None` for the three
+    /// requests the seed dialect has no frame for: is paused (its 0x27 continues), release
+    /// servo (its 0x56 brakes) and is in position with angles (its 0x2A compares a pose).
+    pub fn encode(self, request: &Request) -> Option<Frame> {
+        match self {
+            Self::Pymycobot => Some(request.to_frame()),
+            Self::Seed => seed::encode(request),
+        }
+    }
 }
 
 impl Answer {
@@ -107,7 +123,7 @@ mod seed {
     use heapless::Vec;
 
     use super::{Answer, Translated, returns_value};
-    use crate::command::cmd;
+    use crate::command::{PositionTarget, Request, cmd};
     use crate::frame::{Frame, MAX_DATA};
 
     /// A number no command accepts: where a seed number has no pymycobot equivalent.
@@ -135,6 +151,38 @@ mod seed {
             let _ = out.push(if i == 0 { renumber(b) } else { b });
         }
         out
+    }
+
+    /// Seed number `n` (numbered from 0) of pymycobot's `n` (numbered from 1).
+    fn from_0(n: u8) -> u8 {
+        n.checked_sub(1).unwrap_or(NONE)
+    }
+
+    pub(super) fn encode(request: &Request) -> Option<Frame> {
+        let frame = request.to_frame();
+        let data = frame.data();
+        match request {
+            Request::SendAngle { .. }
+            | Request::GetJointMin { .. }
+            | Request::GetJointMax { .. }
+            | Request::SetJointMin { .. }
+            | Request::SetJointMax { .. }
+            | Request::SendCoord { .. }
+            | Request::SetEncoder { .. }
+            | Request::GetEncoder { .. }
+            | Request::SetServoData { .. }
+            | Request::GetServoData { .. } => Frame::new(frame.cmd(), &first(data, from_0)),
+            Request::SetServoCalibration { .. } => Frame::new(0x55, &first(data, from_0)),
+            Request::JointBrake { .. } => Frame::new(0x56, &first(data, from_0)),
+            Request::Resume => Frame::new(0x27, &[]),
+            Request::Stop => Frame::new(0x28, &[]),
+            Request::IsPaused
+            | Request::ReleaseServo { .. }
+            | Request::IsInPosition {
+                target: PositionTarget::Angles(_),
+            } => None,
+            _ => Some(frame),
+        }
     }
 
     pub(super) fn translate(request: &Frame) -> Translated {
@@ -252,6 +300,72 @@ mod tests {
             assert!(Request::parse(&t.frame).is_err(), "{code:#x}");
             assert_eq!(t.answer, Answer::Silent);
         }
+    }
+
+    /// Every request the recorded pymycobot frames and a sweep of layouts give: its seed frame
+    /// translates back into it, or it is one of the three the seed dialect cannot say.
+    #[test]
+    fn seed_encode_is_the_inverse_of_translate() {
+        let recorded = include_str!("../tests/data/pymycobot_requests.txt")
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .filter_map(|l| l.split('|').next())
+            .map(|hex| {
+                hex.split_whitespace()
+                    .map(|b| u8::from_str_radix(b, 16).unwrap())
+                    .collect::<std::vec::Vec<u8>>()
+            })
+            .filter(|b| b.len() >= 5)
+            .map(|b| frame(b[3], &b[4..b.len() - 1]));
+        let swept = crate::command::cmd::ALL.into_iter().flat_map(|code| {
+            (0..=36usize).flat_map(move |len| {
+                [0u8, 1, 2, 5, 6, 7, 19, 100, 254]
+                    .into_iter()
+                    .map(move |fill| frame(code, &std::vec![fill; len]))
+            })
+        });
+        let mut checked = 0;
+        for f in recorded.chain(swept) {
+            let Ok(request) = Request::parse(&f) else {
+                continue;
+            };
+            assert_eq!(Dialect::Pymycobot.encode(&request), Some(f.clone()));
+            match Dialect::Seed.encode(&request) {
+                Some(seed) => {
+                    let back = Dialect::Seed.translate(&seed).frame;
+                    assert_eq!(Request::parse(&back), Ok(request.clone()), "{seed:?}");
+                }
+                None => assert!(
+                    matches!(
+                        request,
+                        Request::IsPaused
+                            | Request::ReleaseServo { .. }
+                            | Request::IsInPosition {
+                                target: crate::command::PositionTarget::Angles(_)
+                            }
+                    ),
+                    "{request:?}"
+                ),
+            }
+            checked += 1;
+        }
+        assert!(checked > 300, "{checked}");
+    }
+
+    #[test]
+    fn seed_encode_prints_the_manuals_frames() {
+        let enc = |r: Request| Dialect::Seed.encode(&r).unwrap();
+        let j1 = JointId::new(1).unwrap();
+        assert_eq!(enc(Request::GetJointMin { joint: j1 }), frame(0x4A, &[0]));
+        assert_eq!(enc(Request::Resume), frame(0x27, &[]));
+        assert_eq!(enc(Request::Stop), frame(0x28, &[]));
+        let s2 = ServoId::new(2).unwrap();
+        assert_eq!(
+            enc(Request::SetServoCalibration { servo: s2 }),
+            frame(0x55, &[1])
+        );
+        assert_eq!(enc(Request::JointBrake { servo: s2 }), frame(0x56, &[1]));
+        assert_eq!(Dialect::Seed.encode(&Request::IsPaused), None);
     }
 
     #[test]
