@@ -12,6 +12,10 @@
 #[cfg(target_os = "none")]
 pub mod clock;
 pub mod deadline;
+// Raw writes to the unused stack (the module says why).
+#[cfg(all(target_os = "none", target_arch = "riscv32"))]
+#[allow(unsafe_code)]
+pub mod stack_paint;
 #[cfg(target_os = "none")]
 pub mod uart_port;
 #[cfg(target_os = "none")]

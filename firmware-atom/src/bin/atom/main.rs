@@ -42,6 +42,15 @@ esp_bootloader_esp_idf::esp_app_desc!();
 
 #[main]
 fn main() -> ! {
+    // The C3: RAM the bootloader ran code from, written once (board_support::stack_paint).
+    #[cfg(feature = "esp32c3")]
+    board_support::stack_paint::paint_unused_ram();
+    run()
+}
+
+/// Everything `main` does after the stack is painted, in frames of their own.
+#[inline(never)]
+fn run() -> ! {
     let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
     board_support::clock::start(&p);
     // Armed before anything that could hang: from here on only the loop below feeds it.
