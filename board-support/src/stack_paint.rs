@@ -28,6 +28,8 @@ const RECLAIMED_END: usize = 0x3FCD_E710;
 /// stack), so nothing lives in what it writes.
 #[inline(never)]
 pub fn paint_unused_ram() {
+    // SAFETY: both symbols are defined by esp-hal's linker script for this chip; only their
+    // addresses are taken, never their values.
     unsafe extern "C" {
         /// The stack's lowest address (esp-hal's linker script).
         static _stack_end: u32;
