@@ -572,14 +572,21 @@ proptest! {
         let miscounted = |f: &Frame| protocol_core::frame::SEED_MISCOUNTS
             .iter()
             .any(|(c, l, _)| *c == f.cmd() && *l == f.len_byte());
+        // A frame that happens to have a miscounted (CMD, LEN) gets one data byte more or less:
+        // every frame here is one of the other commands' layouts.
+        let other = |f: &Frame| {
+            if !miscounted(f) {
+                return f.clone();
+            }
+            let mut data = f.data().to_vec();
+            if data.len() < protocol_core::frame::MAX_DATA { data.push(0) } else { data.pop(); }
+            Frame::new(f.cmd(), &data).unwrap()
+        };
         let mut bytes = Vec::new();
-        let mut sent = Vec::new();
         for (noise, frame) in &items {
             bytes.extend_from_slice(noise);
-            bytes.extend_from_slice(&frame.to_bytes());
-            sent.push(frame.clone());
+            bytes.extend_from_slice(&other(frame).to_bytes());
         }
-        prop_assume!(!sent.iter().any(miscounted));
         let mut counted = FrameDecoder::new();
         let mut seed = FrameDecoder::new();
         seed.set_lengths(Dialect::Seed.frame_lengths());
