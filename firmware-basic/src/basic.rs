@@ -446,12 +446,19 @@ impl Basic {
 }
 
 /// Acts on what happened to a request: the supervisor watches it (status for the display),
-/// and a reply goes where the router says (the client that asked, or nobody).
+/// and a reply goes where the router says (the client that asked, or nobody), as the
+/// client's dialect wants it; an unanswered request gets what its dialect says then.
 fn deliver(now_us: u64, event: Event, supervisor: &mut Supervisor, router: &mut Router) {
     supervisor.on_event(now_us, &event);
-    if let Event::Reply { request, reply } = event
-        && let Some(reply) = request.answer.reply(&reply)
-        && let Some(delivery) = router.deliver(request.origin, &reply)
+    let (origin, reply) = match event {
+        Event::Reply { request, reply } => (request.origin, request.answer.reply(&reply)),
+        Event::Timeout(request) | Event::GaveUp(request) => {
+            (request.origin, request.answer.unanswered())
+        }
+        _ => return,
+    };
+    if let Some(reply) = reply
+        && let Some(delivery) = router.deliver(origin, &reply)
     {
         supervisor.on_delivery(delivery);
     }
@@ -602,6 +609,30 @@ mod tests {
         assert_eq!(bench.host_got(net), bytes(&reply));
         assert!(bench.host_got(LinkId::USB).is_empty());
         assert_eq!(bench.basic.status().replies_forwarded, 1);
+    }
+
+    #[test]
+    fn a_seed_check_connection_with_the_atom_silent_answers_not_connected() {
+        let (mut bench, net) = Bench::with_network_client();
+        bench.host_sends(LinkId::USB, &frame(cmd::DIALECT, &[2]));
+        bench.run_us(5_000);
+        assert_eq!(
+            bench.host_got(LinkId::USB),
+            bytes(&frame(cmd::DIALECT, &[2]))
+        );
+        bench.host_sends(net, &frame(0x50, &[]));
+        bench.run_us(5_000);
+        assert_eq!(
+            bench.bus.sent,
+            bytes(&frame(cmd::IS_CONTROLLER_CONNECTED, &[]))
+        );
+        assert!(bench.host_got(net).is_empty(), "the Atom has 400 ms");
+        bench.run_us(450_000);
+        assert_eq!(bench.host_got(net), bytes(&frame(0x50, &[0])));
+        // Anything else unanswered stays unanswered.
+        bench.host_sends(net, &frame(cmd::GET_ANGLES, &[]));
+        bench.run_us(450_000);
+        assert!(bench.host_got(net).is_empty());
     }
 
     #[test]

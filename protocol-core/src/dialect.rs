@@ -34,8 +34,9 @@ pub enum Answer {
     AsIs,
     /// Not sent: the command has no return value in the client's dialect.
     Silent,
-    /// Sent under another CMD, the one the client used (seed 0x50 is pymycobot's 0x14).
-    Renamed(u8),
+    /// Seed 0x50, check connection, asked as pymycobot's 0x14: the reply under 0x50, and
+    /// `00` (not connected) when the Atom does not answer ([`Answer::unanswered`]).
+    Connection,
     /// Sent without its first data byte, the number of what was asked (seed 0x4A/0x4B: the
     /// limit without the joint; 0x62: the level without the pin). A refusal (one byte) is sent
     /// as it is.
@@ -90,12 +91,21 @@ impl Dialect {
 }
 
 impl Answer {
+    /// What the client gets when the Atom does not answer its request in time: nothing, but
+    /// for the seed dialect's check connection, whose answer is then "not connected".
+    pub fn unanswered(self) -> Option<Frame> {
+        match self {
+            Self::Connection => Some(Reply::Byte(0).to_frame(seed::CHECK_CONNECTION)),
+            Self::AsIs | Self::Silent | Self::ValueOnly => None,
+        }
+    }
+
     /// What the client gets for `reply`, the pymycobot reply to its translated request.
     pub fn reply(self, reply: &Frame) -> Option<Frame> {
         match self {
             Self::AsIs => Some(reply.clone()),
             Self::Silent => None,
-            Self::Renamed(cmd) => Frame::new(cmd, reply.data()),
+            Self::Connection => Frame::new(seed::CHECK_CONNECTION, reply.data()),
             Self::ValueOnly => match reply.data() {
                 [_, value @ ..] if !value.is_empty() => Frame::new(reply.cmd(), value),
                 _ => Some(reply.clone()),
@@ -125,6 +135,9 @@ mod seed {
     use super::{Answer, Translated, returns_value};
     use crate::command::{PositionTarget, Request, cmd};
     use crate::frame::{Frame, MAX_DATA};
+
+    /// The manual's "check connection" (pymycobot's is-servo-enabled code, without data).
+    pub(super) const CHECK_CONNECTION: u8 = cmd::IS_SERVO_ENABLED;
 
     /// A number no command accepts: where a seed number has no pymycobot equivalent.
     const NONE: u8 = 0xFF;
@@ -219,7 +232,7 @@ mod seed {
                 let frame = Frame::new(cmd::IS_CONTROLLER_CONNECTED, &[]).unwrap_or_default();
                 return Translated {
                     frame,
-                    answer: Answer::Renamed(cmd::IS_SERVO_ENABLED),
+                    answer: Answer::Connection,
                 };
             }
             _ => (code, Vec::from_slice(data).unwrap_or_default()),
@@ -390,6 +403,12 @@ mod tests {
         let t = Dialect::Seed.translate(&frame(0x50, &[]));
         assert_eq!(t.frame, frame(0x14, &[]));
         assert_eq!(t.answer.reply(&frame(0x14, &[1])), Some(frame(0x50, &[1])));
+        assert_eq!(
+            t.answer.unanswered(),
+            Some(frame(0x50, &[0])),
+            "a silent Atom"
+        );
+        assert_eq!(Answer::Silent.unanswered(), None);
         let (_, a) = seed(0x4A, &[0]);
         assert_eq!(
             a.reply(&frame(0x4A, &[1, 0x01, 0x44])),
