@@ -101,14 +101,15 @@ impl BasicFlashStore {
     }
 }
 
-impl WifiStore for BasicFlashStore {
-    fn load(&mut self) -> Result<Option<WifiSettings>, LoadError> {
-        self.store.load()
-    }
-
-    fn save(&mut self, settings: &WifiSettings) -> Result<(), StoreError> {
+impl BasicFlashStore {
+    /// Makes `change` to the flash and then to the file; if the file cannot be written, the
+    /// flash is put back as it was, so the two never differ.
+    fn write_through(
+        &mut self,
+        change: impl FnOnce(&mut FlashWifiStore<BasicFlash>) -> Result<(), StoreError>,
+    ) -> Result<(), StoreError> {
         let before = self.store.clone();
-        self.store.save(settings)?;
+        change(&mut self.store)?;
         if let Some(path) = &self.file
             && self.write_file(path).is_err()
         {
@@ -119,21 +120,23 @@ impl WifiStore for BasicFlashStore {
     }
 }
 
+impl WifiStore for BasicFlashStore {
+    fn load(&mut self) -> Result<Option<WifiSettings>, LoadError> {
+        self.store.load()
+    }
+
+    fn save(&mut self, settings: &WifiSettings) -> Result<(), StoreError> {
+        self.write_through(|store| store.save(settings))
+    }
+}
+
 impl DialectStore for BasicFlashStore {
     fn load_dialect(&mut self) -> Result<Option<protocol_core::dialect::Dialect>, StoreError> {
         self.store.load_dialect()
     }
 
     fn save_dialect(&mut self, dialect: protocol_core::dialect::Dialect) -> Result<(), StoreError> {
-        let before = self.store.clone();
-        self.store.save_dialect(dialect)?;
-        if let Some(path) = &self.file
-            && self.write_file(path).is_err()
-        {
-            self.store = before;
-            return Err(StoreError::Flash);
-        }
-        Ok(())
+        self.write_through(|store| store.save_dialect(dialect))
     }
 }
 

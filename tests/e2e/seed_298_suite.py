@@ -52,6 +52,7 @@ import pymycobot
 from pymycobot.mycobot import MyCobot
 
 from patience import PATIENCE, wait_until
+from reference import rotation_error_deg
 
 if pymycobot.__version__ != "2.9.8":
     raise ImportError(f"this suite is for pymycobot 2.9.8, not {pymycobot.__version__}")
@@ -158,24 +159,6 @@ def near(actual, expected, tol=ANGLE_TOL):
         and len(actual) == len(expected)
         and all(abs(a - e) <= tol for a, e in zip(actual, expected))
     )
-
-
-def rpy_matrix(rx, ry, rz):
-    """R = Rz(rz) * Ry(ry) * Rx(rx), degrees."""
-    a, b, c = math.radians(rx), math.radians(ry), math.radians(rz)
-    ca, sa, cb, sb, cc, sc = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(c), math.sin(c)
-    return [
-        [cc * cb, cc * sb * sa - sc * ca, cc * sb * ca + sc * sa],
-        [sc * cb, sc * sb * sa + cc * ca, sc * sb * ca - cc * sa],
-        [-sb, cb * sa, cb * ca],
-    ]
-
-
-def rotation_error_deg(rpy_a, rpy_b):
-    """Angle of the rotation between two RPY orientations (robust at ry = +-90)."""
-    a, b = rpy_matrix(*rpy_a), rpy_matrix(*rpy_b)
-    trace = sum(a[k][i] * b[k][i] for i in range(3) for k in range(3))
-    return math.degrees(math.acos(max(-1.0, min(1.0, (trace - 1.0) / 2.0))))
 
 
 def pose_near(actual, expected, pos_tol=POS_TOL_MM, rot_tol=ROT_TOL_DEG):

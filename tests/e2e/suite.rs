@@ -60,18 +60,15 @@ impl Robot {
                 .to_string()
         };
         let tcp = value("tcp on ");
-        let view = value("view on http://");
-        let view = view
-            .split_whitespace()
-            .next()
-            .unwrap_or_default()
-            .to_string();
-        let dialect = value("protocol ");
-        let dialect = dialect
-            .split_whitespace()
-            .next()
-            .unwrap_or_default()
-            .to_string();
+        let first_word = |prefix: &str| {
+            value(prefix)
+                .split_whitespace()
+                .next()
+                .unwrap_or_default()
+                .to_string()
+        };
+        let view = first_word("view on http://");
+        let dialect = first_word("protocol ");
         Robot {
             launched,
             link,
