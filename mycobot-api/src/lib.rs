@@ -61,7 +61,7 @@ mod robot;
 
 pub use calls::Angles;
 pub use error::Error;
-pub use robot::{Clock, DEFAULT_REPLY_TIMEOUT_US, MyCobot};
+pub use robot::{Call, Clock, DEFAULT_REPLY_TIMEOUT_US, MyCobot, POLL_READ_BUDGET};
 
 #[cfg(test)]
 mod tests;

@@ -117,6 +117,11 @@ impl<P: BytePort, C: Clock> MyCobot<P, C> {
         (self.port, self.clock)
     }
 
+    /// The clock, to advance it (a program in a super-loop that hands the time in).
+    pub fn clock_mut(&mut self) -> &mut C {
+        &mut self.clock
+    }
+
     /// Sends any request and returns its reply as the pymycobot dialect types it, or `None`
     /// for a command without a value in the seed dialect (nothing comes back). In the seed
     /// dialect, the joint limits (0x4A, 0x4B) and the digital input (0x62), which come back
@@ -124,7 +129,39 @@ impl<P: BytePort, C: Clock> MyCobot<P, C> {
     ///
     /// The typed calls of this crate are built on it; use it for a command they do not cover.
     /// A `00` to a command expecting anything but one byte is a refusal ([`Error::Refused`]).
+    /// It is [`start`](Self::start) and [`poll`](Self::poll) until the call ends.
     pub fn request(&mut self, request: &Request) -> Result<Option<Reply>, Error> {
+        let mut call = self.start(request)?;
+        loop {
+            if let Some(outcome) = self.poll(&mut call) {
+                return outcome;
+            }
+        }
+    }
+
+    /// Writes `request` and returns at once, for a program that must not block (a loop that
+    /// also reads buttons or draws a screen): [`poll`](Self::poll) the [`Call`] until it
+    /// ends. One call at a time: starting another drops what the first would have received.
+    ///
+    /// ```
+    /// use mycobot_api::MyCobot;
+    /// use protocol_core::NullPort;
+    /// use protocol_core::command::Request;
+    /// use protocol_core::dialect::Dialect;
+    ///
+    /// let mut now = 0;
+    /// let mut arm = MyCobot::new(NullPort, move || { now += 1_000; now }, Dialect::Pymycobot);
+    /// let mut call = arm.start(&Request::GetAngles)?;
+    /// let outcome = loop {
+    ///     // ... read the buttons, draw the screen ...
+    ///     if let Some(outcome) = arm.poll(&mut call) {
+    ///         break outcome;
+    ///     }
+    /// };
+    /// assert_eq!(outcome, Err(mycobot_api::Error::Timeout { cmd: 0x20 }));
+    /// # Ok::<(), mycobot_api::Error>(())
+    /// ```
+    pub fn start(&mut self, request: &Request) -> Result<Call, Error> {
         let cmd = request.cmd();
         let frame = self
             .dialect
@@ -142,50 +179,74 @@ impl<P: BytePort, C: Clock> MyCobot<P, C> {
         };
         self.drain();
         self.port.write(&frame.to_bytes());
-        if answer == Answer::Silent {
-            return Ok(None);
-        }
-        let reply = self
-            .await_reply(frame.cmd())
-            .ok_or(Error::Timeout { cmd })?;
-        if reply.data() == [0] && !matches!(wire_kind, ReplyKind::Byte) {
-            return Err(Error::Refused {
-                cmd,
-                code: self.error_code(),
-            });
-        }
-        let parsed = Reply::parse(wire_kind, &reply).map_err(|_| Error::BadReply { cmd })?;
-        let full = match (request, parsed) {
-            (
-                Request::GetJointMin { joint } | Request::GetJointMax { joint },
-                Reply::Int16(limit),
-            ) => Reply::JointLimit {
-                joint: *joint,
-                limit: Decideg(limit),
+        let now = self.clock.now_us();
+        Ok(Call {
+            request: request.clone(),
+            wire_kind,
+            stage: if answer == Answer::Silent {
+                Stage::Written
+            } else {
+                Stage::Reply
             },
-            (Request::GetDigitalInput { pin }, Reply::Byte(level)) => Reply::PinLevel {
-                pin: pin.gpio(),
-                high: match level {
-                    0 => false,
-                    1 => true,
-                    _ => return Err(Error::BadReply { cmd }),
-                },
-            },
-            (_, parsed) => parsed,
-        };
-        Ok(Some(full))
+            wire_cmd: frame.cmd(),
+            deadline_us: now.saturating_add(self.reply_timeout_us),
+            last_byte_us: now,
+        })
     }
 
-    /// The reason for a refusal: get error information (0x07), `None` for "no error" or no
-    /// answer.
-    fn error_code(&mut self) -> Option<ErrorCode> {
-        let frame = self.dialect.encode(&Request::GetErrorInfo)?;
-        self.drain();
-        self.port.write(&frame.to_bytes());
-        let reply = self.await_reply(frame.cmd())?;
-        match reply.data() {
-            [code] => ErrorCode::from_code(*code).filter(|c| *c != ErrorCode::None),
-            _ => None,
+    /// Reads what has arrived for `call`: `None` while its reply may still come, then its
+    /// outcome, as [`request`](Self::request) returns it (once; polling an ended call again
+    /// gives [`Error::Timeout`]). Never blocks: it reads only the bytes already received.
+    pub fn poll(&mut self, call: &mut Call) -> Option<Result<Option<Reply>, Error>> {
+        let cmd = call.request.cmd();
+        let now = self.clock.now_us();
+        match call.stage {
+            Stage::Written => {
+                call.stage = Stage::Ended;
+                Some(Ok(None))
+            }
+            Stage::Ended => Some(Err(Error::Timeout { cmd })),
+            Stage::Reply => {
+                let Some(reply) = self.receive(call, now) else {
+                    return (now >= call.deadline_us).then(|| {
+                        call.stage = Stage::Ended;
+                        Err(Error::Timeout { cmd })
+                    });
+                };
+                if reply.data() == [0] && !matches!(call.wire_kind, ReplyKind::Byte) {
+                    // Refused: ask for the reason, with a deadline of its own.
+                    return match self.dialect.encode(&Request::GetErrorInfo) {
+                        Some(frame) => {
+                            self.drain();
+                            self.port.write(&frame.to_bytes());
+                            let now = self.clock.now_us();
+                            call.stage = Stage::Reason;
+                            call.wire_cmd = frame.cmd();
+                            call.deadline_us = now.saturating_add(self.reply_timeout_us);
+                            call.last_byte_us = now;
+                            None
+                        }
+                        None => {
+                            call.stage = Stage::Ended;
+                            Some(Err(Error::Refused { cmd, code: None }))
+                        }
+                    };
+                }
+                call.stage = Stage::Ended;
+                Some(typed(call, &reply).map(Some))
+            }
+            Stage::Reason => {
+                let code = match self.receive(call, now) {
+                    Some(reply) => match reply.data() {
+                        [code] => ErrorCode::from_code(*code).filter(|c| *c != ErrorCode::None),
+                        _ => None,
+                    },
+                    None if now >= call.deadline_us => None,
+                    None => return None,
+                };
+                call.stage = Stage::Ended;
+                Some(Err(Error::Refused { cmd, code }))
+            }
         }
     }
 
@@ -197,34 +258,90 @@ impl<P: BytePort, C: Clock> MyCobot<P, C> {
         while self.port.read_byte().is_some() && self.clock.now_us() < deadline {}
     }
 
-    /// The first frame with `cmd` before the deadline; other frames and bytes are skipped.
-    fn await_reply(&mut self, cmd: u8) -> Option<Frame> {
-        let start = self.clock.now_us();
-        let deadline = start.saturating_add(self.reply_timeout_us);
-        let mut last_byte_us = start;
-        loop {
-            let now = self.clock.now_us();
+    /// The first frame with the call's CMD among the bytes received by now (at most
+    /// [`POLL_READ_BUDGET`] of them); other frames and bytes are skipped.
+    fn receive(&mut self, call: &mut Call, now: u64) -> Option<Frame> {
+        for _ in 0..POLL_READ_BUDGET {
             let mut found = match self.port.read_byte() {
                 Some(byte) => {
-                    last_byte_us = now;
+                    call.last_byte_us = now;
                     self.decoder.push(byte)
                 }
                 None if self.decoder.has_partial()
-                    && now.saturating_sub(last_byte_us) >= HOST_FRAME_GAP_US =>
+                    && now.saturating_sub(call.last_byte_us) >= HOST_FRAME_GAP_US =>
                 {
                     self.decoder.on_quiet_line()
                 }
-                None => None,
+                None => return None,
             };
             while let Some(frame) = found {
-                if frame.cmd() == cmd {
+                if frame.cmd() == call.wire_cmd {
                     return Some(frame);
                 }
                 found = self.decoder.next_frame();
             }
-            if now >= deadline {
-                return None;
+        }
+        None
+    }
+}
+
+/// Most bytes one [`MyCobot::poll`] reads, so a port that never stops receiving cannot hold it.
+pub const POLL_READ_BUDGET: usize = 256;
+
+/// A request written by [`MyCobot::start`], waiting for its reply.
+#[derive(Debug)]
+pub struct Call {
+    request: Request,
+    /// How the reply's data reads on the wire (the seed dialect's value alone).
+    wire_kind: ReplyKind,
+    stage: Stage,
+    /// The CMD of the frame awaited (the request's, or get error information's).
+    wire_cmd: u8,
+    deadline_us: u64,
+    /// When the last byte came (or the frame was written), for a frame cut short.
+    last_byte_us: u64,
+}
+
+impl Call {
+    /// The request this call sent.
+    pub fn request(&self) -> &Request {
+        &self.request
+    }
+}
+
+/// Where a [`Call`] is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Stage {
+    /// Written, no answer comes (a seed command without a value).
+    Written,
+    /// Waiting for the reply.
+    Reply,
+    /// Refused; waiting for get error information's answer.
+    Reason,
+    /// The outcome was given.
+    Ended,
+}
+
+/// The reply typed as `call`'s request expects it, with the joint or pin a seed value-only
+/// answer leaves out.
+fn typed(call: &Call, reply: &Frame) -> Result<Reply, Error> {
+    let cmd = call.request.cmd();
+    let parsed = Reply::parse(call.wire_kind, reply).map_err(|_| Error::BadReply { cmd })?;
+    Ok(match (&call.request, parsed) {
+        (Request::GetJointMin { joint } | Request::GetJointMax { joint }, Reply::Int16(limit)) => {
+            Reply::JointLimit {
+                joint: *joint,
+                limit: Decideg(limit),
             }
         }
-    }
+        (Request::GetDigitalInput { pin }, Reply::Byte(level)) => Reply::PinLevel {
+            pin: pin.gpio(),
+            high: match level {
+                0 => false,
+                1 => true,
+                _ => return Err(Error::BadReply { cmd }),
+            },
+        },
+        (_, parsed) => parsed,
+    })
 }

@@ -781,3 +781,54 @@ fn any_request_goes_through_request() {
         Err(Error::NotInDialect { cmd: 0x27 })
     );
 }
+
+#[test]
+fn a_started_call_ends_when_its_reply_arrives_and_never_blocks_before() {
+    use protocol_core::command::{Reply, Request};
+    // Nothing answers at first: every poll returns at once, without an outcome.
+    let (mut arm, now) = bot(Dialect::Pymycobot, std::vec![std::vec![]]);
+    let mut call = arm.start(&Request::IsPowerOn).unwrap();
+    for _ in 0..10 {
+        assert_eq!(arm.poll(&mut call), None);
+    }
+    assert!(now.get() < 1_000, "polls read the clock once each");
+    // Then the reply comes, with a reply to something else before it.
+    arm.port_mut().rx.extend(frame(0x20, &[0; 12]));
+    arm.port_mut().rx.extend(frame(0x12, &[1]));
+    assert_eq!(arm.poll(&mut call), Some(Ok(Some(Reply::Byte(1)))));
+    // An ended call stays ended.
+    assert_eq!(arm.poll(&mut call), Some(Err(Error::Timeout { cmd: 0x12 })));
+    assert_eq!(call.request(), &Request::IsPowerOn);
+}
+
+#[test]
+fn a_started_call_that_is_refused_asks_for_the_reason_without_blocking() {
+    use protocol_core::command::Request;
+    let (mut arm, _) = bot(Dialect::Pymycobot, std::vec![std::vec![], std::vec![]]);
+    let request = Request::SendAngle {
+        joint: j(2),
+        angle: Centideg(20000),
+        speed: SpeedPercent::MAX,
+    };
+    let mut call = arm.start(&request).unwrap();
+    arm.port_mut().rx.extend(frame(0x21, &[0]));
+    assert_eq!(arm.poll(&mut call), None, "the reason is asked");
+    assert_eq!(arm.port().written.last().unwrap(), &hex("FE FE 02 07 FA"));
+    assert_eq!(arm.poll(&mut call), None);
+    arm.port_mut().rx.extend(frame(0x07, &[2]));
+    assert_eq!(
+        arm.poll(&mut call),
+        Some(Err(Error::Refused {
+            cmd: 0x21,
+            code: Some(ErrorCode::JointLimit(j(2)))
+        }))
+    );
+}
+
+#[test]
+fn a_started_seed_set_command_ends_at_once() {
+    use protocol_core::command::Request;
+    let (mut arm, _) = bot(Dialect::Seed, std::vec![]);
+    let mut call = arm.start(&Request::PowerOn).unwrap();
+    assert_eq!(arm.poll(&mut call), Some(Ok(None)));
+}
