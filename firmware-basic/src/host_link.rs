@@ -44,13 +44,17 @@ pub enum LinkKind {
     /// A network client (TCP): a frame cut by a quiet gap of [`NETWORK_FRAME_GAP_US`] is
     /// dropped; the client resends after [`NETWORK_REPLY_DEADLINE_US`].
     Network,
+    /// A program running on the Basic itself ([`crate::program`]): its requests come whole,
+    /// from [`mycobot_api`] in the same loop, with the serial line's timings (the crate waits
+    /// 0.5 s for a reply, as the serial client does).
+    Program,
 }
 
 impl LinkKind {
     /// Silence after which a partial frame from this link was cut short, in microseconds.
     pub const fn frame_gap_us(self) -> u64 {
         match self {
-            Self::Serial => timing::HOST_FRAME_GAP_US,
+            Self::Serial | Self::Program => timing::HOST_FRAME_GAP_US,
             Self::Network => NETWORK_FRAME_GAP_US,
         }
     }
@@ -59,7 +63,7 @@ impl LinkKind {
     /// microseconds: 2 ms on the serial line, [`NETWORK_TEXT_GAP_US`] on a network link.
     pub const fn text_gap_us(self) -> u64 {
         match self {
-            Self::Serial => timing::HOST_FRAME_GAP_US,
+            Self::Serial | Self::Program => timing::HOST_FRAME_GAP_US,
             Self::Network => NETWORK_TEXT_GAP_US,
         }
     }
@@ -70,7 +74,7 @@ impl LinkKind {
     /// reply be taken for the answer to the client's next request).
     pub const fn client_deadline_us(self) -> u64 {
         match self {
-            Self::Serial => timing::HOST_REPLY_DEADLINE_US,
+            Self::Serial | Self::Program => timing::HOST_REPLY_DEADLINE_US,
             Self::Network => NETWORK_REPLY_DEADLINE_US,
         }
     }

@@ -61,8 +61,8 @@ pub use basic_flash::{BASIC_FLASH_BYTES, BasicFlash, BasicFlashStore};
 pub use busy_client::BusyClient;
 pub use flash_timing::FlashTiming;
 pub use robot::{
-    AskError, HostLink, NET_BUFFER_BYTES, NetClient, POLL_PERIOD_NS, RobotConfig, SERVO_IDS,
-    SimBasicIo, VirtualRobot,
+    AskError, BasicProgram, HostLink, NET_BUFFER_BYTES, NetClient, POLL_PERIOD_NS, RobotConfig,
+    SERVO_IDS, SimBasicIo, VirtualRobot,
 };
 pub use servo::{Faults, PacketListener, ServoStats, SimServo};
 pub use wire::{Bus, BusByte, HeardByte, SerialLine, StationId};

@@ -4,8 +4,9 @@
 use firmware_atom::collision::Collision;
 use firmware_atom::{Atom, AtomConfig, RecordingIo};
 use firmware_basic::clients::CLIENT_RX_BYTES;
+use firmware_basic::teach::{Teach, TeachStatus};
 use firmware_basic::wifi::WifiStore;
-use firmware_basic::{Basic, BasicConfig, BasicIo, Buttons, NetworkClients};
+use firmware_basic::{Basic, BasicConfig, BasicIo, Buttons, NetworkClients, Programmed};
 use protocol_core::command::{Reply, ReplyError, Request};
 use protocol_core::timing::{HOST_BAUD, HOST_REPLY_DEADLINE_US};
 use protocol_core::units::{Centideg, Steps};
@@ -52,6 +53,64 @@ pub struct RobotConfig {
     pub basic_loop_us: u64,
     /// How long a board stands still for its flash ([`FlashTiming`], typical by default).
     pub flash_timing: FlashTiming,
+    /// A program the Basic runs beside its transponder (`firmware_basic::program`); `None`,
+    /// the shipped Basic, runs none.
+    pub basic_program: Option<BasicProgram>,
+}
+
+/// A program of the Basic's (`firmware_basic::program`), as the board image `basic-teach`
+/// runs it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BasicProgram {
+    /// Teach and play (`firmware_basic::teach`): A records the arm moved by hand, B plays it
+    /// back, C stops.
+    Teach,
+}
+
+/// The Basic's firmware: the transponder alone, or with a program.
+#[derive(Debug)]
+enum BasicFirmware {
+    Transponder(Box<Basic>),
+    Teach(Box<Programmed<Teach>>),
+}
+
+impl BasicFirmware {
+    fn new(config: BasicConfig, program: Option<BasicProgram>) -> Self {
+        match program {
+            None => Self::Transponder(Box::new(Basic::new(config))),
+            Some(BasicProgram::Teach) => {
+                Self::Teach(Box::new(Programmed::new(config, Teach::new())))
+            }
+        }
+    }
+
+    fn basic(&self) -> &Basic {
+        match self {
+            Self::Transponder(basic) => basic,
+            Self::Teach(programmed) => programmed.basic(),
+        }
+    }
+
+    fn basic_mut(&mut self) -> &mut Basic {
+        match self {
+            Self::Transponder(basic) => basic,
+            Self::Teach(programmed) => programmed.basic_mut(),
+        }
+    }
+
+    fn poll<U: protocol_core::BytePort, B: protocol_core::BytePort, I: BasicIo>(
+        &mut self,
+        clients: &mut NetworkClients,
+        now_us: u64,
+        usb: &mut U,
+        bus: &mut B,
+        io: &mut I,
+    ) {
+        match self {
+            Self::Transponder(basic) => clients.poll_basic(basic, now_us, usb, bus, io),
+            Self::Teach(programmed) => programmed.poll(now_us, &mut clients.ports(usb), bus, io),
+        }
+    }
 }
 
 impl Default for RobotConfig {
@@ -70,6 +129,7 @@ impl Default for RobotConfig {
             atom_loop_us: 0,
             basic_loop_us: 0,
             flash_timing: FlashTiming::Typical,
+            basic_program: None,
         }
     }
 }
@@ -268,8 +328,9 @@ impl UsbLink {
 pub const NET_BUFFER_BYTES: usize = CLIENT_RX_BYTES;
 
 struct BasicBoard {
-    firmware: Basic,
+    firmware: BasicFirmware,
     config: BasicConfig,
+    program: Option<BasicProgram>,
     main_loop: BoardLoop,
     /// When the firmware last started, in ns: its clock starts at 0 there.
     boot_ns: u64,
@@ -345,8 +406,9 @@ impl VirtualRobot {
     pub fn new(config: RobotConfig) -> Self {
         let mut bus = Bus::mycobot(config.seed);
         let basic = config.with_basic.then(|| BasicBoard {
-            firmware: Basic::new(config.basic),
+            firmware: BasicFirmware::new(config.basic, config.basic_program),
             config: config.basic,
+            program: config.basic_program,
             main_loop: BoardLoop::new(config.basic_loop_us),
             boot_ns: 0,
             station: bus.attach(config.basic_hears_echo),
@@ -496,7 +558,7 @@ impl VirtualRobot {
     /// included) or the robot has no Basic.
     pub fn connect(&mut self) -> Option<HostLink> {
         let basic = self.basic.as_mut()?;
-        let client = basic.clients.connect(&mut basic.firmware)?;
+        let client = basic.clients.connect(basic.firmware.basic_mut())?;
         Some(HostLink::Network(client))
     }
 
@@ -505,7 +567,7 @@ impl VirtualRobot {
         let (HostLink::Network(client), Some(basic)) = (link, self.basic.as_mut()) else {
             return;
         };
-        basic.clients.disconnect(&mut basic.firmware, client);
+        basic.clients.disconnect(basic.firmware.basic_mut(), client);
     }
 
     /// True while `link` reaches a board: always for the USB ports of the boards there are,
@@ -535,7 +597,7 @@ impl VirtualRobot {
     /// without a Basic.
     pub fn reset_basic(&mut self) {
         if let Some(basic) = self.basic.as_mut() {
-            basic.firmware = Basic::new(basic.config);
+            basic.firmware = BasicFirmware::new(basic.config, basic.program);
             basic.boot_ns = self.now_ns;
             basic.usb = UsbLink::new();
             basic.clients.clear();
@@ -615,8 +677,8 @@ impl VirtualRobot {
             let basic_us = (now_ns - basic.boot_ns) / 1_000;
             let before = io.flash.flash().map(FlashWork::of);
             basic
-                .clients
-                .poll_basic(&mut basic.firmware, basic_us, &mut usb, &mut bus, &mut io);
+                .firmware
+                .poll(&mut basic.clients, basic_us, &mut usb, &mut bus, &mut io);
             let after = io.flash.flash().map(FlashWork::of);
             let until = now_ns + flash_busy_us(before, after, self.flash_timing) * 1_000;
             let board = (&mut basic.main_loop, basic.station, &mut basic.usb);
@@ -833,7 +895,16 @@ impl VirtualRobot {
 
     /// The Basic firmware, if the robot has one.
     pub fn basic(&self) -> Option<&Basic> {
-        self.basic.as_ref().map(|b| &b.firmware)
+        self.basic.as_ref().map(|b| b.firmware.basic())
+    }
+
+    /// What the Basic's teach-and-play program is doing, if it runs one
+    /// ([`RobotConfig::basic_program`]).
+    pub fn teach_status(&self) -> Option<TeachStatus> {
+        match &self.basic.as_ref()?.firmware {
+            BasicFirmware::Teach(programmed) => Some(programmed.program().status()),
+            BasicFirmware::Transponder(_) => None,
+        }
     }
 
     /// The Basic's bus station, if the robot has a Basic.
