@@ -7,3 +7,5 @@ mod loop_time;
 mod radio_start;
 #[path = "screen_text.rs"]
 mod screen_text;
+#[path = "../basic-teach/teach_text.rs"]
+mod teach_text;

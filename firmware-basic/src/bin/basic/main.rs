@@ -180,16 +180,19 @@ fn run() -> ! {
             wifi.poll(now, &mut basic, &mut clients);
         }
         if let Some(screen) = &mut screen {
-            screen.update(now, basic.status(), || BoardStatus {
-                loop_max_us: loop_time.max_us(),
-                #[cfg(feature = "wifi")]
-                wifi: basic.wifi_status(clients.count()),
-                #[cfg(feature = "wifi")]
-                radio: Some(wifi.radio()),
-                #[cfg(not(feature = "wifi"))]
-                wifi: None,
-                #[cfg(not(feature = "wifi"))]
-                radio: None,
+            screen.update(now, || {
+                let board = BoardStatus {
+                    loop_max_us: loop_time.max_us(),
+                    #[cfg(feature = "wifi")]
+                    wifi: basic.wifi_status(clients.count()),
+                    #[cfg(feature = "wifi")]
+                    radio: Some(wifi.radio()),
+                    #[cfg(not(feature = "wifi"))]
+                    wifi: None,
+                    #[cfg(not(feature = "wifi"))]
+                    radio: None,
+                };
+                screen_text::render(&basic.status(), &board)
             });
             screen.draw_next();
         }

@@ -3,16 +3,14 @@
 //! character (~0.1 ms at 40 MHz SPI, well inside the 1.28 ms the 128-byte UART FIFO buffers at
 //! 1 Mbaud).
 
+use crate::screen_text::{
+    Cell, ERROR_ROW, NET_ROW, TITLE_ROW, Text as ScreenText, TextGrid, WIFI_ROW,
+};
 use embedded_graphics::{
     mono_font::{MonoTextStyleBuilder, ascii::FONT_10X20},
     pixelcolor::Rgb565,
     prelude::*,
     text::{Baseline, Text},
-};
-use firmware_basic::BasicStatus;
-
-use crate::screen_text::{
-    self, BoardStatus, Cell, ERROR_ROW, NET_ROW, TITLE_ROW, TextGrid, WIFI_ROW,
 };
 
 /// Cell size of `FONT_10X20`, in pixels.
@@ -25,8 +23,8 @@ const REFORMAT_INTERVAL_US: u64 = 200_000;
 pub struct StatusScreen<D> {
     display: D,
     grid: TextGrid,
-    last_status: Option<(BasicStatus, BoardStatus)>,
-    formatted_at_us: u64,
+    /// When the text was last rebuilt; `None` before the first time.
+    formatted_at_us: Option<u64>,
 }
 
 impl<D: DrawTarget<Color = Rgb565>> StatusScreen<D> {
@@ -35,29 +33,21 @@ impl<D: DrawTarget<Color = Rgb565>> StatusScreen<D> {
         Self {
             display,
             grid: TextGrid::new(),
-            last_status: None,
-            formatted_at_us: 0,
+            formatted_at_us: None,
         }
     }
 
-    /// Notes the transponder's `status` and the `board`'s at `now_us`; the text follows within
-    /// [`REFORMAT_INTERVAL_US`] when it changed. `board` is asked for only then.
-    pub fn update(
-        &mut self,
-        now_us: u64,
-        status: BasicStatus,
-        board: impl FnOnce() -> BoardStatus,
-    ) {
-        let due = now_us.wrapping_sub(self.formatted_at_us) >= REFORMAT_INTERVAL_US;
-        if !due && self.last_status.is_some() {
+    /// Rebuilds the text with `render` at `now_us` if [`REFORMAT_INTERVAL_US`] has passed since
+    /// the last time (`render` is called only then); the cells that changed are drawn next.
+    pub fn update(&mut self, now_us: u64, render: impl FnOnce() -> ScreenText) {
+        if self
+            .formatted_at_us
+            .is_some_and(|at| now_us.wrapping_sub(at) < REFORMAT_INTERVAL_US)
+        {
             return;
         }
-        let now = (status, board());
-        if self.last_status.as_ref() != Some(&now) {
-            self.formatted_at_us = now_us;
-            self.grid.set(screen_text::render(&now.0, &now.1));
-            self.last_status = Some(now);
-        }
+        self.formatted_at_us = Some(now_us);
+        self.grid.set(render());
     }
 
     /// Draws the next character whose text changed, if any.

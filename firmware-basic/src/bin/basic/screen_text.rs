@@ -125,7 +125,7 @@ fn write_wifi_row(out: &mut Line, row: usize, wifi: &WifiStatus) -> fmt::Result 
 }
 
 /// Writes the text of screen row `row`.
-fn write_row(out: &mut Line, row: usize, s: &BasicStatus) -> fmt::Result {
+pub fn write_row(out: &mut Line, row: usize, s: &BasicStatus) -> fmt::Result {
     match row {
         TITLE_ROW => write!(
             out,
@@ -186,8 +186,9 @@ fn yes_no(value: Option<bool>, yes: &'static str, no: &'static str) -> &'static 
 }
 
 /// One row of text, space padded; what does not fit is cut off, non-ASCII shows as '?'.
-struct Line {
-    cells: [u8; COLS],
+pub struct Line {
+    /// The row's characters.
+    pub cells: [u8; COLS],
     len: usize,
 }
 
