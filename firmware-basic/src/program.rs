@@ -16,7 +16,49 @@
 //!   blocking calls of the crate are not offered here: in the loop that must also forward
 //!   their frames, a blocking call would wait for a reply that only the next pass can bring.
 //!
-//! [`crate::teach`] is the worked example: teach and play.
+//! [`crate::teach`] is the worked example: teach and play. A smaller one, a program that
+//! sends the arm home when button A is pressed and remembers how that went:
+//!
+//! ```
+//! use firmware_basic::{Arm, BasicConfig, Buttons, NullIo, Program, Programmed};
+//! use mycobot_api::{Call, Error};
+//! use protocol_core::NullPort;
+//! use protocol_core::command::Request;
+//! use protocol_core::units::{Centideg, SpeedPercent};
+//!
+//! #[derive(Default)]
+//! struct HomeOnA {
+//!     was_down: bool,
+//!     call: Option<Call>,
+//!     last: Option<Result<(), Error>>,
+//! }
+//!
+//! impl Program for HomeOnA {
+//!     fn poll(&mut self, _now_us: u64, buttons: Buttons, arm: &mut Arm) {
+//!         if buttons.a && !self.was_down {
+//!             let home = Request::SendAngles { angles: [Centideg(0); 6], speed: SpeedPercent::MAX };
+//!             match arm.start(&home) {
+//!                 Ok(call) => self.call = Some(call),
+//!                 Err(e) => self.last = Some(Err(e)),
+//!             }
+//!         }
+//!         self.was_down = buttons.a;
+//!         if let Some(call) = self.call.as_mut()
+//!             && let Some(outcome) = arm.poll(call)
+//!         {
+//!             self.last = Some(outcome.map(|_| ()));
+//!             self.call = None;
+//!         }
+//!     }
+//! }
+//!
+//! // On a board: the USB UART, the bus UART and the board's IO; here nothing is attached.
+//! let mut basic = Programmed::new(BasicConfig::default(), HomeOnA::default());
+//! for pass in 0..1_000_u64 {
+//!     basic.poll(pass * 100, &mut NullPort, &mut NullPort, &mut NullIo);
+//! }
+//! assert!(basic.program().last.is_none(), "no button was pressed");
+//! ```
 
 use mycobot_api::{Call, Error, MyCobot};
 use protocol_core::BytePort;
