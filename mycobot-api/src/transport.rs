@@ -14,9 +14,13 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Reads never block for long: a port waits at most [`READ_WAIT`] for a byte when it has none
+//! Reads block only briefly: a port waits at most [`READ_WAIT`] for a byte when it has none
 //! buffered (so a call waiting for its reply does not spin a core), reads whatever has come in
-//! one system call and hands it out byte by byte. Writes write everything before returning.
+//! one system call and hands it out byte by byte. While a frame is under way (the last byte
+//! handed out was not a frame's end, `FA`) it waits up to [`FRAME_WAIT`] instead: a sender that
+//! pauses inside a frame (a USB bridge, the virtual robot on a busy machine) would otherwise
+//! have the frame taken for cut short ([`HOST_FRAME_GAP_US`](protocol_core::timing::HOST_FRAME_GAP_US))
+//! and its reply lost. Writes write everything before returning.
 //! An I/O error cannot be returned through [`BytePort`]: the port keeps the first one for
 //! [`take_error`](SerialPort::take_error), and the call that met it times out.
 
@@ -36,6 +40,12 @@ pub const BAUD: u32 = 115_200;
 /// Longest a read waits for a byte when none is buffered.
 pub const READ_WAIT: Duration = Duration::from_millis(1);
 
+/// Longest a read waits for the rest of a frame under way.
+pub const FRAME_WAIT: Duration = Duration::from_millis(100);
+
+/// A frame's last byte.
+const FRAME_END: u8 = 0xFA;
+
 /// How long [`TcpPort::connect`] tries each address.
 pub const CONNECT_TIMEOUT: Duration = Duration::from_secs(3);
 
@@ -48,6 +58,8 @@ struct Inbox {
     buf: [u8; READ_CHUNK],
     next: usize,
     end: usize,
+    /// The last byte handed out was not a frame's end.
+    mid_frame: bool,
     error: Option<io::Error>,
 }
 
@@ -57,17 +69,32 @@ impl Inbox {
             buf: [0; READ_CHUNK],
             next: 0,
             end: 0,
+            mid_frame: false,
             error: None,
         }
     }
 
-    /// The next byte: a buffered one, else whatever `read` brings (waiting at most as long as
-    /// the source's timeout). Time-outs are "nothing there"; other errors are kept.
-    fn read_byte(&mut self, read: impl FnOnce(&mut [u8]) -> io::Result<usize>) -> Option<u8> {
+    /// How long the next read may wait: [`FRAME_WAIT`] inside a frame, else [`READ_WAIT`].
+    fn wait(&self) -> Duration {
+        if self.mid_frame {
+            FRAME_WAIT
+        } else {
+            READ_WAIT
+        }
+    }
+
+    /// The next byte: a buffered one, else whatever `read` brings, waiting at most the time it
+    /// is given. Time-outs are "nothing there"; other errors are kept.
+    fn read_byte(
+        &mut self,
+        read: impl FnOnce(&mut [u8], Duration) -> io::Result<usize>,
+    ) -> Option<u8> {
         if self.next >= self.end {
             self.next = 0;
             self.end = 0;
-            match read(&mut self.buf) {
+            let wait = self.wait();
+            self.mid_frame = false;
+            match read(&mut self.buf, wait) {
                 Ok(0) => {
                     self.keep(io::Error::new(
                         io::ErrorKind::ConnectionAborted,
@@ -85,6 +112,7 @@ impl Inbox {
         }
         let byte = self.buf.get(self.next).copied();
         self.next += 1;
+        self.mid_frame = byte.is_some_and(|b| b != FRAME_END);
         byte
     }
 
@@ -144,7 +172,8 @@ impl SerialPort {
         Ok(Self::from_port(port))
     }
 
-    /// Wraps a port opened by the caller (its settings and read timeout as they are).
+    /// Wraps a port opened by the caller (its settings as they are; its read timeout is set
+    /// as reads need it).
     pub fn from_port(port: Box<dyn serialport::SerialPort>) -> Self {
         Self {
             port,
@@ -166,7 +195,12 @@ impl SerialPort {
 impl BytePort for SerialPort {
     fn read_byte(&mut self) -> Option<u8> {
         let port = &mut self.port;
-        self.inbox.read_byte(|buf| port.read(buf))
+        self.inbox.read_byte(|buf, wait| {
+            if port.timeout() != wait {
+                port.set_timeout(wait)?;
+            }
+            port.read(buf)
+        })
     }
 
     /// Writes all of `bytes` and waits until they have left (tcdrain).
@@ -186,6 +220,8 @@ impl BytePort for SerialPort {
 #[derive(Debug)]
 pub struct TcpPort {
     stream: TcpStream,
+    /// The stream's read timeout.
+    read_wait: Duration,
     inbox: Inbox,
 }
 
@@ -212,6 +248,7 @@ impl TcpPort {
         stream.set_read_timeout(Some(READ_WAIT))?;
         Ok(Self {
             stream,
+            read_wait: READ_WAIT,
             inbox: Inbox::new(),
         })
     }
@@ -230,8 +267,14 @@ impl TcpPort {
 
 impl BytePort for TcpPort {
     fn read_byte(&mut self) -> Option<u8> {
-        let stream = &mut self.stream;
-        self.inbox.read_byte(|buf| stream.read(buf))
+        let (stream, waiting) = (&mut self.stream, &mut self.read_wait);
+        self.inbox.read_byte(|buf, wait| {
+            if *waiting != wait {
+                stream.set_read_timeout(Some(wait))?;
+                *waiting = wait;
+            }
+            stream.read(buf)
+        })
     }
 
     /// Writes all of `bytes` (blocking until the system has taken them).
@@ -397,6 +440,25 @@ mod tests {
             .take_error()
             .expect("the closed connection is reported");
         assert_eq!(e.kind(), io::ErrorKind::ConnectionAborted);
+    }
+
+    #[test]
+    fn a_reply_paused_inside_its_frame_still_comes_through() {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap();
+        let server = thread::spawn(move || {
+            let (mut peer, _) = listener.accept().unwrap();
+            let mut request = [0u8; 5];
+            peer.read_exact(&mut request).unwrap();
+            // Is powered on: yes, with a pause ten times the frame gap after its fourth byte.
+            peer.write_all(&[0xFE, 0xFE, 0x03, 0x12]).unwrap();
+            thread::sleep(Duration::from_millis(20));
+            peer.write_all(&[0x01, 0xFA]).unwrap();
+            request
+        });
+        let mut arm = MyCobot::connect_tcp(addr, Dialect::Pymycobot).unwrap();
+        assert_eq!(arm.is_powered_on(), Ok(true));
+        assert_eq!(server.join().unwrap(), [0xFE, 0xFE, 0x02, 0x12, 0xFA]);
     }
 
     #[test]
