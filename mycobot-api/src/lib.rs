@@ -51,13 +51,15 @@
 //!
 //! Which calls exist, and what each sends: the [`MyCobot`] methods; [`MyCobot::request`]
 //! sends any other command of [`protocol_core::command::Request`].
-#![cfg_attr(not(test), no_std)]
+#![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![forbid(unsafe_code)]
 
 mod calls;
 pub mod convert;
 mod error;
 mod robot;
+#[cfg(feature = "std")]
+pub mod transport;
 
 pub use calls::Angles;
 pub use error::Error;
