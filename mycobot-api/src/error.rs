@@ -89,6 +89,27 @@ impl core::fmt::Display for Error {
 
 impl core::error::Error for Error {}
 
+/// What an error code means, in words (`docs/protocol.md` section 7), as a refusal's
+/// `Display` gives it.
+///
+/// ```
+/// use mycobot_api::Reason;
+/// use protocol_core::command::ErrorCode;
+///
+/// assert_eq!(
+///     Reason(ErrorCode::IkNoSolution).to_string(),
+///     "no inverse-kinematics solution for the pose"
+/// );
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Reason(pub ErrorCode);
+
+impl core::fmt::Display for Reason {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        describe(self.0, f)
+    }
+}
+
 /// The meaning of an error code (`docs/protocol.md` section 7).
 fn describe(code: ErrorCode, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
     match code {

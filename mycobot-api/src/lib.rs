@@ -62,8 +62,10 @@ mod robot;
 pub mod transport;
 
 pub use calls::Angles;
-pub use error::Error;
-pub use robot::{Call, Clock, DEFAULT_REPLY_TIMEOUT_US, MyCobot, POLL_READ_BUDGET};
+pub use error::{Error, Reason};
+pub use robot::{
+    Call, Clock, DEFAULT_REPLY_TIMEOUT_US, MyCobot, POLL_READ_BUDGET, REPLY_FRAME_GAP_US,
+};
 
 #[cfg(test)]
 mod tests;

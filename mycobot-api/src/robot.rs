@@ -4,7 +4,7 @@ use protocol_core::command::{ErrorCode, Reply, ReplyKind, Request};
 use protocol_core::dialect::{Answer, Dialect};
 use protocol_core::frame::{Frame, FrameDecoder};
 use protocol_core::port::BytePort;
-use protocol_core::timing::{HOST_FRAME_GAP_US, HOST_REPLY_DEADLINE_US};
+use protocol_core::timing::HOST_REPLY_DEADLINE_US;
 use protocol_core::units::Decideg;
 
 use crate::error::Error;
@@ -22,6 +22,15 @@ impl<F: FnMut() -> u64> Clock for F {
     }
 }
 
+/// Silence inside a reply after which what came of it is dropped, in microseconds: 20 ms. A
+/// sender may pause inside a reply (a USB-serial bridge's latency timer, 16 ms on FTDI's by
+/// default; a busy PC relaying TCP; the virtual robot on a loaded machine), and a reply dropped
+/// for a pause is lost. What the gap is for is garbage: a false frame start whose LEN runs past
+/// the real reply hides it until the gap ends, which then costs the call 20 ms. (The serial
+/// line's own 2 ms gap, `HOST_FRAME_GAP_US`, is the firmware's rule for cutting a request
+/// short.)
+pub const REPLY_FRAME_GAP_US: u64 = 20_000;
+
 /// How long a call waits for its reply unless told otherwise: 500 ms, pymycobot's deadline
 /// and the seed manual's.
 pub const DEFAULT_REPLY_TIMEOUT_US: u64 = HOST_REPLY_DEADLINE_US;
@@ -38,7 +47,7 @@ pub const DEFAULT_REPLY_TIMEOUT_US: u64 = HOST_REPLY_DEADLINE_US;
 ///
 /// Replies are found with a [`FrameDecoder`] reading LEN as counted (both dialects answer so):
 /// bytes outside frames are skipped, a frame with another CMD is ignored, a frame cut short
-/// is dropped once the line has been quiet for [`HOST_FRAME_GAP_US`], and what was received
+/// is dropped once the line has been quiet for [`REPLY_FRAME_GAP_US`], and what was received
 /// before a request is dropped when it is written (a late reply to an earlier call cannot be
 /// taken for this one's). That is right for a host link, which carries nothing but the
 /// robot's replies; it is not a station on the shared bus between the Basic and the Atom
@@ -268,7 +277,7 @@ impl<P: BytePort, C: Clock> MyCobot<P, C> {
                     self.decoder.push(byte)
                 }
                 None if self.decoder.has_partial()
-                    && now.saturating_sub(call.last_byte_us) >= HOST_FRAME_GAP_US =>
+                    && now.saturating_sub(call.last_byte_us) >= REPLY_FRAME_GAP_US =>
                 {
                     self.decoder.on_quiet_line()
                 }

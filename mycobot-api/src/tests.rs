@@ -607,7 +607,7 @@ fn a_refusal_without_a_code() {
 #[test]
 fn garbage_and_a_false_start_before_the_reply_are_skipped() {
     // Noise, a servo packet's start, and a frame header whose LEN (0x30) runs past the
-    // reply: the reply is found once the line has been quiet for the frame gap.
+    // reply: the reply is found once the line has been quiet for the reply frame gap.
     let garbage = hex("00 FA FE 13 FF FF 01 02 FE FE 30 20");
     for Answered {
         case,

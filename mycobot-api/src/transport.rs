@@ -16,11 +16,7 @@
 //!
 //! Reads block only briefly: a port waits at most [`READ_WAIT`] for a byte when it has none
 //! buffered (so a call waiting for its reply does not spin a core), reads whatever has come in
-//! one system call and hands it out byte by byte. While a frame is under way (the last byte
-//! handed out was not a frame's end, `FA`) it waits up to [`FRAME_WAIT`] instead: a sender that
-//! pauses inside a frame (a USB bridge, the virtual robot on a busy machine) would otherwise
-//! have the frame taken for cut short ([`HOST_FRAME_GAP_US`](protocol_core::timing::HOST_FRAME_GAP_US))
-//! and its reply lost. Writes write everything before returning.
+//! one system call and hands it out byte by byte. Writes write everything before returning.
 //! An I/O error cannot be returned through [`BytePort`]: the port keeps the first one for
 //! [`take_error`](SerialPort::take_error), and the call that met it times out.
 
@@ -40,12 +36,6 @@ pub const BAUD: u32 = 115_200;
 /// Longest a read waits for a byte when none is buffered.
 pub const READ_WAIT: Duration = Duration::from_millis(1);
 
-/// Longest a read waits for the rest of a frame under way.
-pub const FRAME_WAIT: Duration = Duration::from_millis(100);
-
-/// A frame's last byte.
-const FRAME_END: u8 = 0xFA;
-
 /// How long [`TcpPort::connect`] tries each address.
 pub const CONNECT_TIMEOUT: Duration = Duration::from_secs(3);
 
@@ -58,8 +48,6 @@ struct Inbox {
     buf: [u8; READ_CHUNK],
     next: usize,
     end: usize,
-    /// The last byte handed out was not a frame's end.
-    mid_frame: bool,
     error: Option<io::Error>,
 }
 
@@ -69,22 +57,12 @@ impl Inbox {
             buf: [0; READ_CHUNK],
             next: 0,
             end: 0,
-            mid_frame: false,
             error: None,
         }
     }
 
-    /// How long the next read may wait: [`FRAME_WAIT`] inside a frame, else [`READ_WAIT`].
-    fn wait(&self) -> Duration {
-        if self.mid_frame {
-            FRAME_WAIT
-        } else {
-            READ_WAIT
-        }
-    }
-
-    /// The next byte: a buffered one, else whatever `read` brings, waiting at most the time it
-    /// is given. Time-outs are "nothing there"; other errors are kept.
+    /// The next byte: a buffered one, else whatever `read` brings, waiting at most
+    /// [`READ_WAIT`]. Time-outs are "nothing there"; other errors are kept.
     fn read_byte(
         &mut self,
         read: impl FnOnce(&mut [u8], Duration) -> io::Result<usize>,
@@ -92,9 +70,7 @@ impl Inbox {
         if self.next >= self.end {
             self.next = 0;
             self.end = 0;
-            let wait = self.wait();
-            self.mid_frame = false;
-            match read(&mut self.buf, wait) {
+            match read(&mut self.buf, READ_WAIT) {
                 Ok(0) => {
                     self.keep(io::Error::new(
                         io::ErrorKind::ConnectionAborted,
@@ -112,7 +88,6 @@ impl Inbox {
         }
         let byte = self.buf.get(self.next).copied();
         self.next += 1;
-        self.mid_frame = byte.is_some_and(|b| b != FRAME_END);
         byte
     }
 
@@ -450,9 +425,10 @@ mod tests {
             let (mut peer, _) = listener.accept().unwrap();
             let mut request = [0u8; 5];
             peer.read_exact(&mut request).unwrap();
-            // Is powered on: yes, with a pause ten times the frame gap after its fourth byte.
+            // Is powered on: yes, with a pause five times the serial line's frame gap (half the
+            // reply gap, REPLY_FRAME_GAP_US) after its fourth byte.
             peer.write_all(&[0xFE, 0xFE, 0x03, 0x12]).unwrap();
-            thread::sleep(Duration::from_millis(20));
+            thread::sleep(Duration::from_millis(10));
             peer.write_all(&[0x01, 0xFA]).unwrap();
             request
         });

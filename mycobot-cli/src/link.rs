@@ -86,13 +86,5 @@ fn io_failure(e: std::io::Error) -> Failure {
 
 /// What an error code means, in the words [`Error`]'s `Display` gives a refusal.
 pub fn error_reason(code: ErrorCode) -> String {
-    let refused = Error::Refused {
-        cmd: 0,
-        code: Some(code),
-    }
-    .to_string();
-    match refused.split_once(": ") {
-        Some((_, reason)) => reason.to_owned(),
-        None => refused,
-    }
+    mycobot_api::Reason(code).to_string()
 }
