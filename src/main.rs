@@ -82,7 +82,7 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
             format!("cannot serve the view on {addr}: {e}")
         })?;
         let model = web::snapshot::model_json(&kinematics_core::ArmGeometry::MYCOBOT_280);
-        let server = WebServer::start(listening.listener, Arc::clone(&board), model)
+        let server = WebServer::start(listening.listener, Arc::clone(&board), model, None)
             .map_err(|e| format!("cannot start the view's server: {e}"))?;
         Some((server, listening.default_taken))
     };
