@@ -12,6 +12,7 @@ use clap::Parser;
 use firmware_atom::collision::Collision;
 use firmware_basic::DialectStore;
 use firmware_basic::wifi::WifiConfig;
+use open_mycobot::host::buttons::{PressQueue, Presser, spawn_key_reader};
 use open_mycobot::host::cli::{Cli, DialectArg, Port, default_basic_flash};
 use open_mycobot::host::emulated::{CONNECT_TIMEOUT, Chardev, EmulatedBoards};
 use open_mycobot::host::pty::PseudoTerminal;
@@ -53,6 +54,17 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
                 .into(),
         );
     }
+    if let Some(program) = cli.basic_program
+        && cli.emulated_atom.is_some()
+    {
+        return Err(format!(
+            "--basic-program {}: with --emulated-* the boards run their real images, and a \
+             Basic running {0} would be the image basic-teach, which tools/emulate does not \
+             run yet",
+            program.name()
+        )
+        .into());
+    }
     if let Some(atom) = cli.emulated_atom {
         return serve_emulated(cli, atom, &stop, pty, link);
     }
@@ -73,6 +85,9 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
         })
         .transpose()?;
 
+    // The Basic's buttons, pressed by the keys a, b, c and the view's buttons, when a program
+    // of its own has them.
+    let presses = cli.basic_program.map(|_| PressQueue::new());
     let board = Arc::new(StateBoard::new());
     let view = if cli.no_web {
         None
@@ -82,8 +97,13 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
             format!("cannot serve the view on {addr}: {e}")
         })?;
         let model = web::snapshot::model_json(&kinematics_core::ArmGeometry::MYCOBOT_280);
-        let server = WebServer::start(listening.listener, Arc::clone(&board), model)
-            .map_err(|e| format!("cannot start the view's server: {e}"))?;
+        let server = WebServer::start(
+            listening.listener,
+            Arc::clone(&board),
+            model,
+            presses.clone(),
+        )
+        .map_err(|e| format!("cannot start the view's server: {e}"))?;
         Some((server, listening.default_taken))
     };
 
@@ -118,8 +138,17 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
         }
         None => {}
     }
+    if let Some(program) = cli.basic_program {
+        writeln!(
+            out,
+            "basic program {} (keys a, b, c or the view's buttons: A records a hand move, B \
+             plays it, C stops)",
+            program.name()
+        )?;
+    }
     let mut config = RobotConfig {
         flash_timing: cli.flash_timing,
+        basic_program: cli.basic_program.map(Into::into),
         ..RobotConfig::default()
     };
     config.basic.dialect = cli.dialect.map(Dialect::from);
@@ -145,6 +174,17 @@ fn serve(cli: &Cli) -> Result<(), Box<dyn std::error::Error>> {
         driver = driver.follow_server_port(Ipv4Addr::LOCALHOST.into(), |moved| match moved {
             Ok(addr) => println!("tcp on {addr} (set_server_port)"),
             Err(e) => eprintln!("open-mycobot: the Basic's new server port cannot be had: {e}"),
+        });
+    }
+    if let Some(presses) = presses {
+        spawn_key_reader(presses.clone())
+            .map_err(|e| format!("cannot read the keys on standard input: {e}"))?;
+        let mut presser = Presser::new(presses);
+        driver = driver.each_pass(move |served: &mut ServedRobot| {
+            let now_us = served.robot.now_us();
+            if let Some(io) = served.robot.basic_io_mut() {
+                presser.apply(now_us, &mut io.buttons);
+            }
         });
     }
     let publish = view.is_some();

@@ -7,7 +7,7 @@ use clap::{Parser, ValueEnum};
 
 use crate::sim::contact::Obstacle;
 use crate::sim::reply_faults::ReplyFault;
-use crate::sim::{FlashTiming, HostLink};
+use crate::sim::{BasicProgram, FlashTiming, HostLink};
 
 /// Virtual myCobot 280 M5: the real Basic and Atom firmware logic, simulated servos, served in
 /// real time on a pseudo-terminal (and optionally TCP) to pymycobot or any serial client, with
@@ -73,6 +73,15 @@ pub struct Cli {
     #[arg(long = "lost-replies", value_name = "ID:PER_MILLE", value_parser = ReplyFault::lost)]
     pub lost_replies: Vec<ReplyFault>,
 
+    /// A program the Basic runs beside its transponder, as a board flashed with its image
+    /// does: `teach`, teach and play (the image basic-teach): A records the arm moved by hand,
+    /// B plays the record back, C stops. Its buttons are pressed by the keys a, b and c on the
+    /// robot's standard input (each followed by Enter on a terminal) and by the buttons of the
+    /// 3D view, which shows what the program does. Without a program the keys are not read and
+    /// the view has no buttons. Not with `--emulated-*`: the emulated Basic runs its own image.
+    #[arg(long, value_enum, value_name = "PROGRAM")]
+    pub basic_program: Option<BasicProgramArg>,
+
     /// How long a board stands still while its flash erases or writes (loop stopped, UART
     /// receiving into its 128-byte FIFO only): the datasheet's typical times, its worst case,
     /// or no time at all.
@@ -121,6 +130,30 @@ impl From<DialectArg> for protocol_core::dialect::Dialect {
         match arg {
             DialectArg::Pymycobot => Self::Pymycobot,
             DialectArg::Seed => Self::Seed,
+        }
+    }
+}
+
+/// A program of the Basic's, as the command line names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BasicProgramArg {
+    /// Teach and play: A records a hand move, B plays it back, C stops.
+    Teach,
+}
+
+impl BasicProgramArg {
+    /// The program's name on the command line and in the start-up lines.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Teach => "teach",
+        }
+    }
+}
+
+impl From<BasicProgramArg> for BasicProgram {
+    fn from(arg: BasicProgramArg) -> Self {
+        match arg {
+            BasicProgramArg::Teach => Self::Teach,
         }
     }
 }
@@ -255,6 +288,20 @@ mod tests {
             Cli::try_parse_from(["open-mycobot", "--no-web", "--web", "127.0.0.1:0"]).is_err(),
             "both is a contradiction"
         );
+    }
+
+    #[test]
+    fn the_basic_program_is_named_on_the_command_line() {
+        let bare = Cli::try_parse_from(["open-mycobot"]).unwrap();
+        assert_eq!(bare.basic_program, None);
+        let teach = Cli::try_parse_from(["open-mycobot", "--basic-program", "teach"]).unwrap();
+        assert_eq!(teach.basic_program, Some(BasicProgramArg::Teach));
+        assert_eq!(
+            teach.basic_program.map(BasicProgram::from),
+            Some(BasicProgram::Teach)
+        );
+        assert_eq!(BasicProgramArg::Teach.name(), "teach");
+        assert!(Cli::try_parse_from(["open-mycobot", "--basic-program", "dance"]).is_err());
     }
 
     #[test]

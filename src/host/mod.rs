@@ -8,8 +8,10 @@
 //! * [`realtime`]: the loop that runs the robot at wall-clock speed and moves the bytes;
 //! * [`emulated`]: the bus and servos serving the real images on emulated chips (QEMU), through
 //!   their UART sockets;
+//! * [`buttons`]: the Basic's front buttons pressed from the keyboard and the 3D view;
 //! * [`cli`]: the command line.
 
+pub mod buttons;
 pub mod cli;
 pub mod emulated;
 pub mod pacer;

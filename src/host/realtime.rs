@@ -181,6 +181,9 @@ struct Observer<R> {
 /// What an [`Observer`] does when it looks: sees the robot and how late it has run.
 type Look<R> = Box<dyn FnMut(&R, &Lateness) + Send>;
 
+/// What runs on every pass of the loop with the robot in hand ([`RealtimeDriver::each_pass`]).
+type Pass<R> = Box<dyn FnMut(&mut R) + Send>;
+
 impl<R> Observer<R> {
     /// Looks if it is time; keeps a steady rate, but never makes up for missed turns.
     fn look_if_due(&mut self, robot: &R, late: &Lateness) {
@@ -211,6 +214,7 @@ pub struct RealtimeDriver<R> {
     tcp_links: Vec<(ClientId, HostLink)>,
     pacer: LinePacer,
     observer: Option<Observer<R>>,
+    each_pass: Option<Pass<R>>,
     late: Lateness,
     /// Told how late the robot ran, at most every [`LATE_REPORT_PERIOD`] while it runs late.
     report_late: Box<dyn FnMut(&Lateness) + Send>,
@@ -227,6 +231,7 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             tcp_links: Vec::new(),
             pacer: LinePacer::new(HOST_BAUD, WINDOW_BYTES),
             observer: None,
+            each_pass: None,
             late: Lateness::default(),
             report_late: Box::new(|late| {
                 eprintln!("open-mycobot: the machine is too busy, the robot ran late: {late}");
@@ -260,6 +265,16 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
             next: Instant::now(),
             look: Box::new(look),
         });
+        self
+    }
+
+    /// Calls `pass` with the robot on every pass of the loop, right after virtual time has
+    /// caught up with the wall clock and before the clients' bytes are handed over: to act on
+    /// the robot from outside at the virtual time it has reached (the Basic's buttons pressed
+    /// from the keyboard or the view). A pass comes at least every [`IDLE_TICK`]; `pass` runs
+    /// on the loop's thread, so it must be quick and never wait.
+    pub fn each_pass(mut self, pass: impl FnMut(&mut R) + Send + 'static) -> Self {
+        self.each_pass = Some(Box::new(pass));
         self
     }
 
@@ -310,6 +325,9 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
                 virtual_at_sync = target_us;
             }
             self.robot.run_until(target_us);
+            if let Some(pass) = self.each_pass.as_mut() {
+                pass(&mut self.robot);
+            }
             if let Some(observer) = self.observer.as_mut() {
                 observer.look_if_due(&self.robot, &self.late);
             }
@@ -747,6 +765,31 @@ mod tests {
         assert_eq!(looks.len(), 10);
         // The k-th look is due k periods after the start, never earlier.
         assert!(looks[9] - start >= 9 * period, "{:?}", looks[9] - start);
+    }
+
+    #[test]
+    fn each_pass_gets_the_robot_after_virtual_time_advanced() {
+        let stop = Arc::new(AtomicBool::new(false));
+        let seen = Arc::new(std::sync::Mutex::new(Vec::new()));
+        let robot = IdleRobot { now_us: 0 };
+        let driver = RealtimeDriver::new(robot, PseudoTerminal::open().unwrap(), None).each_pass({
+            let seen = Arc::clone(&seen);
+            let stop = Arc::clone(&stop);
+            move |robot: &mut IdleRobot| {
+                let mut seen = seen.lock().unwrap();
+                seen.push(robot.now_us);
+                // It may act on the robot: here it moves its clock on a little.
+                robot.now_us += 1;
+                if seen.len() == 20 {
+                    stop.store(true, Ordering::Relaxed);
+                }
+            }
+        });
+        let robot = driver.run(&stop).unwrap();
+        let seen = seen.lock().unwrap();
+        assert_eq!(seen.len(), 20, "one call per pass until the stop");
+        assert!(seen.windows(2).all(|w| w[1] > w[0]), "{seen:?}");
+        assert_eq!(robot.now_us, seen[19] + 1);
     }
 
     /// Checks on every write that no more arrived than the 115200 line could carry.

@@ -1,6 +1,8 @@
 //! The view's web server, in threads of its own: the page and its assets, the arm's model
-//! (`/model.json`), and the state stream (`/state`, a WebSocket that sends every snapshot the
-//! simulation publishes as one JSON text message, about 60 a second).
+//! (`/model.json`), the state stream (`/state`, a WebSocket that sends every snapshot the
+//! simulation publishes as one JSON text message, about 60 a second), and the Basic's buttons
+//! (`POST /button/a`, `b` or `c`: one press, queued for the simulation, when the Basic runs a
+//! program; answered 204 at once).
 //!
 //! Requests are parsed by httparse (hyper's HTTP/1.x parser); the WebSocket handshake and
 //! framing are tungstenite's. What is left here is routing: each connection carries one
@@ -19,6 +21,7 @@ use tungstenite::{Bytes, Message, WebSocket};
 
 use super::assets::{self, Asset};
 use super::board::StateBoard;
+use crate::host::buttons::{Button, PressQueue};
 
 /// Most connections served at once, streams included (each costs a thread); more are closed
 /// at once.
@@ -45,17 +48,20 @@ pub struct WebServer {
 
 impl WebServer {
     /// Serves the view on `listener`, with the state that `board` receives and the model
-    /// `model_json`, until dropped.
+    /// `model_json`, until dropped. `presses`: where the view's button presses go when the
+    /// Basic runs a program (`None`: no buttons, `POST /button/..` is answered 409).
     pub fn start(
         listener: TcpListener,
         board: Arc<StateBoard>,
         model_json: String,
+        presses: Option<PressQueue>,
     ) -> io::Result<Self> {
         let addr = listener.local_addr()?;
         let stop = Arc::new(AtomicBool::new(false));
         let site = Arc::new(Site {
             board,
             model_json,
+            presses,
             stop: Arc::clone(&stop),
             connections: AtomicUsize::new(0),
         });
@@ -95,6 +101,7 @@ impl Drop for WebServer {
 struct Site {
     board: Arc<StateBoard>,
     model_json: String,
+    presses: Option<PressQueue>,
     stop: Arc<AtomicBool>,
     connections: AtomicUsize,
 }
@@ -133,8 +140,10 @@ enum Route {
     Stream,
     /// `/state` without the upgrade.
     NotAWebSocket,
-    /// Anything but GET.
-    MethodNotAllowed,
+    /// `POST /button/a` (`b`, `c`): press one of the Basic's buttons.
+    Button(Button),
+    /// A method the path does not take: the one it takes.
+    MethodNotAllowed(&'static str),
     /// No such path.
     NotFound,
 }
@@ -143,12 +152,24 @@ enum Route {
 /// whether it asks for a WebSocket.
 fn route(method: &str, target: &str, websocket: bool) -> Route {
     let path = target.split('?').next().unwrap_or_default();
+    if let Some(name) = path.strip_prefix("/button/") {
+        let mut letters = name.chars();
+        let button = match (letters.next(), letters.next()) {
+            (Some(letter), None) if letter.is_ascii_lowercase() => Button::from_letter(letter),
+            _ => None,
+        };
+        return match (method, button) {
+            (_, None) => Route::NotFound,
+            ("POST", Some(button)) => Route::Button(button),
+            _ => Route::MethodNotAllowed("POST"),
+        };
+    }
     match (method, path) {
         ("GET", "/state") if websocket => Route::Stream,
         ("GET", "/state") => Route::NotAWebSocket,
         ("GET", "/model.json") => Route::Model,
         ("GET", path) => assets::find(path).map_or(Route::NotFound, Route::Asset),
-        _ => Route::MethodNotAllowed,
+        _ => Route::MethodNotAllowed("GET"),
     }
 }
 
@@ -184,8 +205,38 @@ impl Site {
                 "text/plain",
                 b"the state stream is a WebSocket",
             ),
-            Route::MethodNotAllowed => respond(stream, 405, "text/plain", b"GET only"),
+            Route::Button(button) => self.press(stream, button, &request),
+            Route::MethodNotAllowed(allowed) => {
+                let only = format!("{allowed} only");
+                respond(stream, 405, "text/plain", only.as_bytes())
+            }
             Route::NotFound => respond(stream, 404, "text/plain", b"not found"),
+        }
+    }
+
+    /// Queues a press of `button` for the Basic's program, if it runs one. A request a page of
+    /// another site sent (its `Origin` is not this server) is refused: only the view presses.
+    fn press(&self, stream: TcpStream, button: Button, request: &RequestHead) -> io::Result<()> {
+        if !request.same_origin() {
+            return respond(
+                stream,
+                403,
+                "text/plain",
+                b"only the view's page presses buttons",
+            );
+        }
+        let Some(presses) = &self.presses else {
+            return respond(
+                stream,
+                409,
+                "text/plain",
+                b"the Basic runs no program (--basic-program)",
+            );
+        };
+        if presses.push(button) {
+            respond(stream, 204, "text/plain", b"")
+        } else {
+            respond(stream, 503, "text/plain", b"too many presses waiting")
         }
     }
 
@@ -216,6 +267,24 @@ struct RequestHead {
     target: String,
     /// `Upgrade: websocket` is present.
     websocket: bool,
+    /// The `Host` header, if any.
+    host: Option<String>,
+    /// The `Origin` header, if any (a browser sends it with every POST).
+    origin: Option<String>,
+}
+
+impl RequestHead {
+    /// Whether the request comes from this server's own page, or from no page at all (a
+    /// client that is not a browser sends no `Origin`): not from another site's page.
+    fn same_origin(&self) -> bool {
+        match (&self.origin, &self.host) {
+            (None, _) => true,
+            (Some(origin), Some(host)) => origin
+                .strip_prefix("http://")
+                .is_some_and(|origin_host| origin_host.eq_ignore_ascii_case(host)),
+            (Some(_), None) => false,
+        }
+    }
 }
 
 /// Reads until a complete request head has arrived (at most [`HEAD_LIMIT`] bytes); returns
@@ -237,10 +306,19 @@ fn read_head(mut stream: &TcpStream) -> io::Result<(Vec<u8>, RequestHead)> {
                     h.name.eq_ignore_ascii_case("upgrade")
                         && h.value.eq_ignore_ascii_case(b"websocket")
                 });
+                let header = |name: &str| {
+                    request
+                        .headers
+                        .iter()
+                        .find(|h| h.name.eq_ignore_ascii_case(name))
+                        .map(|h| String::from_utf8_lossy(h.value).into_owned())
+                };
                 let head = RequestHead {
                     method: request.method.unwrap_or_default().to_string(),
                     target: request.path.unwrap_or_default().to_string(),
                     websocket,
+                    host: header("host"),
+                    origin: header("origin"),
                 };
                 return Ok((buf, head));
             }
@@ -257,15 +335,27 @@ fn read_head(mut stream: &TcpStream) -> io::Result<(Vec<u8>, RequestHead)> {
 fn respond(mut stream: TcpStream, status: u16, content_type: &str, body: &[u8]) -> io::Result<()> {
     let reason = match status {
         200 => "OK",
+        204 => "No Content",
         400 => "Bad Request",
+        403 => "Forbidden",
         404 => "Not Found",
         405 => "Method Not Allowed",
+        409 => "Conflict",
+        503 => "Service Unavailable",
         _ => "",
     };
+    // A 204 has no body, so says nothing about one.
+    let content = if status == 204 {
+        String::new()
+    } else {
+        format!(
+            "Content-Type: {content_type}\r\nContent-Length: {}\r\n",
+            body.len()
+        )
+    };
     let head = format!(
-        "HTTP/1.1 {status} {reason}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\n\
-         Cache-Control: no-cache\r\nConnection: close\r\n\r\n",
-        body.len()
+        "HTTP/1.1 {status} {reason}\r\n{content}Cache-Control: no-cache\r\n\
+         Connection: close\r\n\r\n"
     );
     stream.write_all(head.as_bytes())?;
     stream.write_all(body)?;
@@ -308,10 +398,14 @@ mod tests {
     use crate::web::snapshot::Snapshot;
 
     fn serve() -> (WebServer, Arc<StateBoard>) {
+        serve_with(None)
+    }
+
+    fn serve_with(presses: Option<PressQueue>) -> (WebServer, Arc<StateBoard>) {
         let board = Arc::new(StateBoard::new());
         let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-        let server =
-            WebServer::start(listener, Arc::clone(&board), "{\"d_mm\":[]}".into()).unwrap();
+        let model = "{\"d_mm\":[]}".into();
+        let server = WebServer::start(listener, Arc::clone(&board), model, presses).unwrap();
         (server, board)
     }
 
@@ -336,8 +430,82 @@ mod tests {
         assert_eq!(route("GET", "/model.json", false), Route::Model);
         assert_eq!(route("GET", "/state", true), Route::Stream);
         assert_eq!(route("GET", "/state", false), Route::NotAWebSocket);
-        assert_eq!(route("POST", "/", false), Route::MethodNotAllowed);
+        assert_eq!(route("POST", "/", false), Route::MethodNotAllowed("GET"));
         assert_eq!(route("GET", "/../etc/passwd", false), Route::NotFound);
+        assert_eq!(route("POST", "/button/a", false), Route::Button(Button::A));
+        assert_eq!(
+            route("POST", "/button/b?x=1", false),
+            Route::Button(Button::B)
+        );
+        assert_eq!(route("POST", "/button/c", false), Route::Button(Button::C));
+        assert_eq!(
+            route("GET", "/button/a", false),
+            Route::MethodNotAllowed("POST")
+        );
+        assert_eq!(
+            route("PUT", "/button/c", false),
+            Route::MethodNotAllowed("POST")
+        );
+        for other in [
+            "/button/d",
+            "/button/A",
+            "/button/ab",
+            "/button/",
+            "/button/a/b",
+        ] {
+            assert_eq!(route("POST", other, false), Route::NotFound, "{other}");
+        }
+    }
+
+    fn post(addr: SocketAddr, path: &str, origin: Option<&str>) -> String {
+        let origin = origin.map_or(String::new(), |o| format!("Origin: {o}\r\n"));
+        send(
+            addr,
+            &format!("POST {path} HTTP/1.1\r\nHost: {addr}\r\n{origin}Content-Length: 0\r\n\r\n"),
+        )
+    }
+
+    #[test]
+    fn a_posted_button_is_queued_for_the_program_and_other_letters_are_not_found() {
+        let presses = PressQueue::new();
+        let (server, _) = serve_with(Some(presses.clone()));
+        let addr = server.local_addr();
+        let page = format!("http://{addr}");
+        let pressed = post(addr, "/button/a", Some(&page));
+        assert!(
+            pressed.starts_with("HTTP/1.1 204 No Content\r\n"),
+            "{pressed}"
+        );
+        assert!(!pressed.contains("Content-Length"), "{pressed}");
+        assert!(post(addr, "/button/c", None).starts_with("HTTP/1.1 204"));
+        assert!(post(addr, "/button/x", Some(&page)).starts_with("HTTP/1.1 404"));
+        assert!(get(addr, "/button/b").starts_with("HTTP/1.1 405"));
+        let elsewhere = post(addr, "/button/b", Some("http://evil.example"));
+        assert!(elsewhere.starts_with("HTTP/1.1 403"), "{elsewhere}");
+
+        let mut presser = crate::host::buttons::Presser::new(presses);
+        let mut buttons = firmware_basic::Buttons::default();
+        presser.apply(0, &mut buttons);
+        assert_eq!(presser.holding(), Some(Button::A));
+        presser.apply(1_000_000, &mut buttons);
+        presser.apply(2_000_000, &mut buttons);
+        assert_eq!(
+            presser.holding(),
+            Some(Button::C),
+            "A, then C; B was refused"
+        );
+        presser.apply(3_000_000, &mut buttons);
+        presser.apply(4_000_000, &mut buttons);
+        assert_eq!(presser.holding(), None);
+    }
+
+    #[test]
+    fn without_a_program_a_button_is_a_conflict() {
+        let (server, _) = serve();
+        let addr = server.local_addr();
+        let refused = post(addr, "/button/a", None);
+        assert!(refused.starts_with("HTTP/1.1 409"), "{refused}");
+        assert!(refused.ends_with("--basic-program)"), "{refused}");
     }
 
     #[test]

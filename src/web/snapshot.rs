@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 
 use firmware_atom::cartesian::{self, Cartesian};
 use firmware_atom::collision::Kind;
+use firmware_basic::teach::{Activity, SAMPLE_PERIOD_US, TeachStatus};
 use kinematics_core::ArmGeometry;
 use kinematics_core::geometry::DH_ALPHA_CENTIDEG;
 use protocol_core::command::{EndType, Pose, ReferenceFrame};
@@ -46,6 +47,9 @@ pub struct Snapshot {
     /// How late the simulation has run behind the wall clock because the machine could not
     /// keep up (zero in virtual-time runs).
     pub late: Lateness,
+    /// What the Basic's teach-and-play program is doing, when it runs one
+    /// ([`VirtualRobot::teach_status`]).
+    pub teach: Option<TeachStatus>,
 }
 
 /// A collision as the view marks it: which joint, what error, when.
@@ -93,6 +97,7 @@ impl Snapshot {
                 })
             }),
             late: Lateness::default(),
+            teach: robot.teach_status(),
         }
     }
 
@@ -108,8 +113,13 @@ impl Snapshot {
     ///  "coords":[x_mm,y_mm,z_mm,rx_deg,ry_deg,rz_deg],"end":"flange","frame":"base",
     ///  "tool":null,"gripper":50,"led":[255,0,0],"powered":true,"moving":false,
     ///  "collision":{"joint":2,"code":16,"during":"moving joints","t_s":3.25},
-    ///  "late_ms":0,"late_stalls":0,"protocol":"pymycobot"}
+    ///  "late_ms":0,"late_stalls":0,"protocol":"pymycobot",
+    ///  "basic_program":{"name":"teach","activity":"recording","points":81,"played":0,
+    ///                   "plays":2,"error":null,"lines":["now       RECORDING",...]}}
     /// ```
+    ///
+    /// `basic_program`: the Basic's program and what it does ([`teach_json`]), or `null` when
+    /// it runs none.
     ///
     /// `protocol`: the dialect the Basic's clients speak, or `null` without a Basic.
     ///
@@ -164,12 +174,93 @@ impl Snapshot {
         );
         match self.dialect {
             Some(d) => {
-                let _ = write!(out, "\"{}\"}}", d.name());
+                let _ = write!(out, "\"{}\"", d.name());
             }
-            None => out.push_str("null}"),
+            None => out.push_str("null"),
         }
+        out.push_str(",\"basic_program\":");
+        match &self.teach {
+            Some(teach) => push_teach(&mut out, teach),
+            None => out.push_str("null"),
+        }
+        out.push('}');
         out
     }
+}
+
+/// The teach program's status as the view gets it: `{"name":"teach","activity":..,
+/// "points":..,"played":..,"plays":..,"error":"text"|null,"lines":[..]}`; `activity` is
+/// `idle`, `recording`, `approaching`, `playing`, `settling` or `stopping`, `lines` what the
+/// board's screen says of it ([`teach_lines`]).
+fn push_teach(out: &mut String, teach: &TeachStatus) {
+    let activity = match teach.activity {
+        Activity::Idle => "idle",
+        Activity::Recording => "recording",
+        Activity::Approaching => "approaching",
+        Activity::Playing => "playing",
+        Activity::Settling => "settling",
+        Activity::Stopping => "stopping",
+    };
+    let _ = write!(
+        out,
+        "{{\"name\":\"teach\",\"activity\":\"{activity}\",\"points\":{},\"played\":{},\
+         \"plays\":{},\"error\":",
+        teach.points, teach.played, teach.plays
+    );
+    match &teach.error {
+        Some(error) => push_string(out, &error.to_string()),
+        None => out.push_str("null"),
+    }
+    out.push_str(",\"lines\":[");
+    for (i, line) in teach_lines(teach).iter().enumerate() {
+        if i > 0 {
+            out.push(',');
+        }
+        push_string(out, line);
+    }
+    out.push_str("]}");
+}
+
+/// What the teach-and-play image's screen says of the program (its rows 4 to 6, in the
+/// words of `render_teach` in `firmware-basic/src/bin/basic-teach/teach_text.rs`): what it
+/// is doing, the record's length, the playbacks finished.
+pub fn teach_lines(teach: &TeachStatus) -> [String; 3] {
+    let now = match teach.activity {
+        Activity::Idle if teach.points == 0 => "move by hand after A".to_string(),
+        Activity::Idle => "ready".to_string(),
+        Activity::Recording => "RECORDING".to_string(),
+        Activity::Approaching => "to the first point".to_string(),
+        Activity::Playing => format!("PLAYING {}/{}", teach.played, teach.points),
+        Activity::Settling => "to the last point".to_string(),
+        Activity::Stopping => "stopping".to_string(),
+    };
+    let tenths_s = u64::from(teach.points) * SAMPLE_PERIOD_US / 100_000;
+    [
+        format!("now       {now}"),
+        format!(
+            "record    {} points, {}.{} s",
+            teach.points,
+            tenths_s / 10,
+            tenths_s % 10
+        ),
+        format!("played    {} times", teach.plays),
+    ]
+}
+
+/// `text` as a JSON string, quotes, backslashes and control characters escaped.
+fn push_string(out: &mut String, text: &str) {
+    out.push('"');
+    for c in text.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if u32::from(c) < 0x20 => {
+                let _ = write!(out, "\\u{:04x}", u32::from(c));
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
 }
 
 /// The end pose at `angles` as the Atom reports it (its frames, its rounding to the wire).
@@ -293,6 +384,13 @@ mod tests {
                 stalls: 2,
                 worst_us: 1_000,
             },
+            teach: Some(TeachStatus {
+                activity: Activity::Playing,
+                points: 81,
+                played: 12,
+                plays: 2,
+                error: None,
+            }),
         };
         assert_eq!(
             parse(&snapshot.to_json()),
@@ -311,6 +409,15 @@ mod tests {
                 "late_ms": 1.25,
                 "late_stalls": 2.0,
                 "protocol": "seed",
+                "basic_program": {
+                    "name": "teach",
+                    "activity": "playing",
+                    "points": 81.0,
+                    "played": 12.0,
+                    "plays": 2.0,
+                    "error": null,
+                    "lines": ["now       PLAYING 12/81", "record    81 points, 4.0 s", "played    2 times"],
+                },
             }))
         );
     }
@@ -335,6 +442,7 @@ mod tests {
                 stalls: u32::MAX,
                 worst_us: u64::MAX,
             },
+            teach: None,
         };
         let value = parse(&snapshot.to_json());
         assert_eq!(value["angles_deg"][0], json!(-327.68));
@@ -343,6 +451,62 @@ mod tests {
         assert_eq!(value["end"], json!("flange"));
         assert_eq!(value["collision"], Value::Null);
         assert_eq!(value["protocol"], Value::Null);
+        assert_eq!(value["basic_program"], Value::Null);
+    }
+
+    #[test]
+    fn text_in_the_json_is_escaped() {
+        let mut out = String::new();
+        push_string(&mut out, "a \"quote\", a \\ and a\nline");
+        assert_eq!(
+            serde_json::from_str::<String>(&out).unwrap(),
+            "a \"quote\", a \\ and a\nline"
+        );
+    }
+
+    #[test]
+    fn the_teach_lines_are_the_boards_screen_words() {
+        let idle = TeachStatus::default();
+        assert_eq!(
+            teach_lines(&idle),
+            [
+                "now       move by hand after A",
+                "record    0 points, 0.0 s",
+                "played    0 times"
+            ]
+        );
+        let recording = TeachStatus {
+            activity: Activity::Recording,
+            points: 81,
+            ..idle
+        };
+        assert_eq!(teach_lines(&recording)[0], "now       RECORDING");
+        assert_eq!(teach_lines(&recording)[1], "record    81 points, 4.0 s");
+        let ready = TeachStatus {
+            activity: Activity::Idle,
+            points: 3,
+            plays: 1,
+            ..idle
+        };
+        assert_eq!(teach_lines(&ready)[0], "now       ready");
+        assert_eq!(teach_lines(&ready)[2], "played    1 times");
+    }
+
+    #[test]
+    fn a_robot_running_teach_carries_its_status_and_one_without_does_not() {
+        let mut robot = VirtualRobot::new(RobotConfig::default());
+        robot.run_for(50_000);
+        assert_eq!(Snapshot::of(&robot).teach, None);
+        let mut teach = VirtualRobot::new(RobotConfig {
+            basic_program: Some(crate::sim::BasicProgram::Teach),
+            ..RobotConfig::default()
+        });
+        teach.run_for(50_000);
+        let snapshot = Snapshot::of(&teach);
+        assert_eq!(snapshot.teach, Some(TeachStatus::default()));
+        let value = parse(&snapshot.to_json());
+        assert_eq!(value["basic_program"]["activity"], json!("idle"));
+        assert_eq!(value["basic_program"]["error"], Value::Null);
     }
 
     #[test]

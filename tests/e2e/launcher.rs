@@ -1,7 +1,7 @@
 //! Starts and stops the virtual robot binary for the integration tests (included with
 //! `#[path]` by tests/pymycobot*.rs).
 
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::sync::mpsc;
 use std::thread;
@@ -40,6 +40,19 @@ impl Launched {
         self.lines.try_iter().collect()
     }
 
+    /// Types `keys` on the robot's standard input (a pipe kept open while it runs).
+    #[allow(
+        dead_code,
+        reason = "only some of the test crates that include this file type keys"
+    )]
+    pub fn type_keys(&mut self, keys: &str) {
+        let stdin = self.child.stdin.as_mut().expect("piped stdin");
+        stdin
+            .write_all(keys.as_bytes())
+            .expect("type on the robot's stdin");
+        stdin.flush().expect("flush the robot's stdin");
+    }
+
     /// Sends `signal` and waits for the exit; kills the robot and returns None if it hangs.
     pub fn stop_with(&mut self, signal: Signal) -> Option<ExitStatus> {
         let pid = Pid::from_raw(i32::try_from(self.child.id()).ok()?);
@@ -68,10 +81,12 @@ impl Drop for Launched {
 
 /// Starts the robot binary with `args` and waits for its "ready" line. Its stdout keeps being
 /// drained afterwards, so the robot never blocks on (or fails writing to) a full pipe; the
-/// lines are kept for [`Launched::printed_after_ready`].
+/// lines are kept for [`Launched::printed_after_ready`]. Its stdin is a pipe the test holds
+/// ([`Launched::type_keys`]), never the terminal the tests run in.
 pub fn launch(args: &[&str]) -> Launched {
     let mut child = Command::new(env!("CARGO_BIN_EXE_open-mycobot"))
         .args(args)
+        .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .spawn()
         .expect("start the virtual robot");

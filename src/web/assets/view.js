@@ -37,6 +37,32 @@ function showReadout(state) {
   }
   $('status').textContent = status.join(' \u00b7 ');
   showCollision(state.collision);
+  showProgram(state.basic_program);
+}
+
+// The Basic's own program (--basic-program), when it runs one: its name, what the board's
+// screen says of it, and why its last record or playback ended early.
+const PROGRAM_TITLES = { teach: 'teach and play' };
+
+function showProgram(program) {
+  $('program').hidden = !program;
+  if (!program) return;
+  $('program-name').textContent = PROGRAM_TITLES[program.name] ?? program.name;
+  $('program-lines').textContent = program.lines.join('\n');
+  $('program-error').hidden = !program.error;
+  $('program-error').textContent = program.error ?? '';
+}
+
+// A click presses the Basic's button (held 150 ms of the robot's time, as a finger would).
+for (const button of document.querySelectorAll('#program button[data-button]')) {
+  button.addEventListener('click', async () => {
+    try {
+      const answer = await fetch(`/button/${button.dataset.button}`, { method: 'POST' });
+      if (!answer.ok) showError(`button ${button.textContent}: ${await answer.text()}`);
+    } catch (e) {
+      showError(`button ${button.textContent}: ${e.message}`);
+    }
+  });
 }
 
 // The collision the Atom detected and the host has not cleared: its joint's row marked, and a
@@ -121,7 +147,7 @@ let scheduled = false;
 // Everything in a state message that is read out or drawn, except the time: an arm at rest
 // sends the same key 60 times a second, and then the page does nothing.
 const keyOf = (s) =>
-  JSON.stringify([s.angles_deg, s.coords, s.end, s.frame, s.tool, s.gripper, s.led, s.powered, s.moving, s.collision, s.late_stalls, s.protocol]);
+  JSON.stringify([s.angles_deg, s.coords, s.end, s.frame, s.tool, s.gripper, s.led, s.powered, s.moving, s.collision, s.late_stalls, s.protocol, s.basic_program]);
 
 function schedule() {
   if (!scheduled) {
