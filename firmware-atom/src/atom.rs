@@ -21,7 +21,7 @@ use protocol_core::{BytePort, Frame};
 use crate::collision::{Collision, CollisionSettings};
 use crate::config::{AtomConfig, ConfigError, JOINTS, JointLimit, SERVOS};
 use crate::context::Context;
-use crate::driver::{Op, Outcome};
+use crate::driver::{Op, Outcome, Taken};
 use crate::flash_writes::QUIET_US;
 use crate::io::AtomIo;
 use crate::link::{Link, READ_BUDGET, UsbLink};
@@ -149,11 +149,24 @@ impl Atom {
                     self.schedule.send_reply(reply);
                 }
             }
-            BusEvent::Packet(packet) => {
-                if let Some((op, outcome)) = self.schedule.on_packet(packet) {
-                    self.finish(now_us, op, outcome, usb, io);
+            BusEvent::Packet(packet) => match self.schedule.on_packet(packet) {
+                Some(Taken::Finished(op, outcome)) => self.finish(now_us, op, outcome, usb, io),
+                Some(Taken::Late {
+                    op,
+                    answer,
+                    sent_us,
+                }) => {
+                    // A state read of the refresh is dated when it was asked (the state is
+                    // at least that old); anything else, a read a job waits for, is done now.
+                    let at = if self.parts.bank.is_refresh_read(&op) {
+                        sent_us
+                    } else {
+                        now_us
+                    };
+                    self.finish(at, op, Outcome::Answered(answer), usb, io);
                 }
-            }
+                None => {}
+            },
         }
     }
 

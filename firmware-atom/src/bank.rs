@@ -657,6 +657,11 @@ impl ServoBank {
         self.refresh_rounds
     }
 
+    /// True if `op` is a state read of the refresh round (not one a job waits for).
+    pub fn is_refresh_read(&self, op: &Op) -> bool {
+        is_state_read(op) && !self.jobs.front().is_some_and(|j| j.op == *op)
+    }
+
     /// Applies the result of a transaction that finished at `now_us`; `corrupt` says the
     /// receiver saw a bad checksum during it. A timed-out operation with retries left stays
     /// queued; one with a ticket that is done is handed back ([`Finished`]).
@@ -670,14 +675,7 @@ impl ServoBank {
     ) -> Option<Finished> {
         let config = settings.config();
         let index = config.servo_ids.iter().position(|&id| id == op.id());
-        let is_state_read = matches!(
-            op,
-            Op::Read {
-                addr: STATE_READ_ADDR,
-                count: STATE_READ_LEN,
-                ..
-            }
-        );
+        let is_state_read = is_state_read(&op);
         let job_matches = self.jobs.front().is_some_and(|j| j.op == op);
         if is_state_read && !job_matches {
             let i = index?;
@@ -802,6 +800,18 @@ fn believable(s: &Servo, now_us: u64, speed_max: i64) -> bool {
     let elapsed_us = now_us.saturating_sub(s.trusted_us) + READ_SLACK_US;
     let reach = speed_max.saturating_mul(elapsed_us.min(10_000_000) as i64) / 1_000_000;
     moved <= reach + READ_SLACK_STEPS
+}
+
+/// True if `op` reads a servo's state (the refresh's READ).
+fn is_state_read(op: &Op) -> bool {
+    matches!(
+        op,
+        Op::Read {
+            addr: STATE_READ_ADDR,
+            count: STATE_READ_LEN,
+            ..
+        }
+    )
 }
 
 /// Servo state reads and banks that have read them, for the unit tests of the parts that act

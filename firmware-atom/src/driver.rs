@@ -112,13 +112,55 @@ pub enum Outcome {
 #[derive(Clone, Debug)]
 struct InFlight {
     op: Op,
+    /// When its instruction was written.
+    sent_us: u64,
     deadline_us: u64,
+}
+
+/// How long after its deadline the answer to a READ is still taken, if it comes whole: a servo
+/// that answers late (its return delay, a busy servo) or an answer held up on its way (an
+/// emulated board's socket) is still the servo's state, read after the instruction went out.
+/// On a real bus the Atom does not start its next instruction while another station's bytes are
+/// on the wire, so a late answer under way arrives whole; one that meets the next instruction
+/// arrives garbled and is not taken. Shorter than the bank's read slack (10 ms), so a late
+/// answer never makes a reading look staler or faster than it is.
+pub const LATE_ANSWER_WINDOW_US: u64 = 5_000;
+
+/// Most timed-out READs whose answers are still awaited at once.
+const OVERDUE_MAX: usize = 4;
+
+/// A READ that timed out, whose answer is taken until `until_us` if it comes whole.
+#[derive(Clone, Debug)]
+struct Overdue {
+    op: Op,
+    sent_us: u64,
+    until_us: u64,
+}
+
+/// A servo packet the driver took: the answer to the transaction in flight, or the late
+/// answer to a READ that timed out ([`LATE_ANSWER_WINDOW_US`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Taken {
+    /// The transaction in flight ended.
+    Finished(Op, Outcome),
+    /// A READ that timed out was answered after all; `sent_us`: when its instruction went out
+    /// (the state it carries was read after that).
+    Late {
+        /// The READ.
+        op: Op,
+        /// Its answer.
+        answer: Packet,
+        /// When its instruction was written.
+        sent_us: u64,
+    },
 }
 
 /// Runs one servo transaction at a time.
 #[derive(Clone, Debug, Default)]
 pub struct ServoDriver {
     in_flight: Option<InFlight>,
+    /// READs that timed out lately, oldest first.
+    overdue: Vec<Overdue, OVERDUE_MAX>,
     reply_margin_us: u64,
 }
 
@@ -127,6 +169,7 @@ impl ServoDriver {
     pub fn new(reply_margin_us: u64) -> Self {
         Self {
             in_flight: None,
+            overdue: Vec::new(),
             reply_margin_us,
         }
     }
@@ -151,6 +194,8 @@ impl ServoDriver {
         let Some(packet) = op.packet() else {
             return false;
         };
+        // A new instruction to the same servo: an answer to an older one is no longer taken.
+        self.overdue.retain(|o| o.op.id() != op.id());
         let bytes = packet.to_bytes();
         bus.write(&bytes);
         rx.on_transmit(now_us, &bytes);
@@ -164,29 +209,34 @@ impl ServoDriver {
             .unwrap_or(0);
         self.in_flight = Some(InFlight {
             op,
+            sent_us: now_us,
             deadline_us: sent_us + answer_us + self.reply_margin_us,
         });
         true
     }
 
-    /// Offers a received servo packet; returns the finished transaction if it answers it.
-    pub fn on_packet(&mut self, packet: Packet) -> Option<(Op, Outcome)> {
-        let flight = self.in_flight.as_ref()?;
-        if flight.op.answer_data_len().is_none() || packet.id() != flight.op.id() {
-            return None;
-        }
-        if let Op::Read { count, .. } = flight.op
-            && packet.params().len() != usize::from(count)
+    /// Offers a received servo packet: the answer to the transaction in flight, or else the
+    /// late answer to a READ that timed out; `None` if it is neither.
+    pub fn on_packet(&mut self, packet: Packet) -> Option<Taken> {
+        if let Some(flight) = self.in_flight.as_ref()
+            && answers(&flight.op, &packet)
         {
-            return None;
+            let flight = self.in_flight.take()?;
+            return Some(Taken::Finished(flight.op, Outcome::Answered(packet)));
         }
-        let flight = self.in_flight.take()?;
-        Some((flight.op, Outcome::Answered(packet)))
+        let late = self.overdue.iter().position(|o| answers(&o.op, &packet))?;
+        let overdue = self.overdue.remove(late);
+        Some(Taken::Late {
+            op: overdue.op,
+            answer: packet,
+            sent_us: overdue.sent_us,
+        })
     }
 
     /// Ends the transaction in flight if its time is up: a broadcast once it has left the
     /// transmitter, an answerable one at its deadline.
     pub fn poll<B: BytePort>(&mut self, now_us: u64, bus: &B) -> Option<(Op, Outcome)> {
+        self.overdue.retain(|o| now_us <= o.until_us);
         let flight = self.in_flight.as_ref()?;
         let done = match flight.op.answer_data_len() {
             None => bus.tx_idle() || now_us >= flight.deadline_us,
@@ -201,7 +251,28 @@ impl ServoDriver {
         } else {
             Outcome::Sent
         };
+        if matches!(flight.op, Op::Read { .. }) {
+            if self.overdue.is_full() {
+                self.overdue.remove(0);
+            }
+            let _ = self.overdue.push(Overdue {
+                op: flight.op.clone(),
+                sent_us: flight.sent_us,
+                until_us: flight.deadline_us.saturating_add(LATE_ANSWER_WINDOW_US),
+            });
+        }
         Some((flight.op, outcome))
+    }
+}
+
+/// True if `packet` is the answer `op` expects: from its servo, and for a READ as long as asked.
+fn answers(op: &Op, packet: &Packet) -> bool {
+    if op.answer_data_len().is_none() || packet.id() != op.id() {
+        return false;
+    }
+    match op {
+        Op::Read { count, .. } => packet.params().len() == usize::from(*count),
+        _ => true,
     }
 }
 
@@ -238,10 +309,81 @@ mod tests {
         ));
         assert_eq!(d.on_packet(status(4, &[0, 8])), None, "another servo");
         assert_eq!(d.on_packet(status(3, &[0])), None, "short answer");
-        let (op, outcome) = d.on_packet(status(3, &[0, 8])).unwrap();
+        let Some(Taken::Finished(op, outcome)) = d.on_packet(status(3, &[0, 8])) else {
+            panic!("the answer ends the transaction");
+        };
         assert_eq!(op.id(), 3);
         assert_eq!(outcome, Outcome::Answered(status(3, &[0, 8])));
         assert!(!d.busy());
+    }
+
+    fn read(id: u8) -> Op {
+        Op::Read {
+            id,
+            addr: 56,
+            count: 2,
+        }
+    }
+
+    /// A READ of servo `id` sent at 0 and timed out (its deadline: 80 us out, 40 us
+    /// turnaround, 80 us back, 150 us margin).
+    fn timed_out(d: &mut ServoDriver, id: u8) {
+        start(d, read(id));
+        assert_eq!(d.poll(1_000, &NullPort), Some((read(id), Outcome::TimedOut)));
+    }
+
+    #[test]
+    fn a_late_answer_that_comes_whole_is_taken_with_the_time_its_read_was_sent() {
+        let mut d = ServoDriver::new(150);
+        timed_out(&mut d, 3);
+        // The next transaction is under way when the late answer comes.
+        start(&mut d, read(4));
+        assert_eq!(d.on_packet(status(3, &[0])), None, "short answer");
+        assert_eq!(
+            d.on_packet(status(3, &[0, 8])),
+            Some(Taken::Late {
+                op: read(3),
+                answer: status(3, &[0, 8]),
+                sent_us: 0,
+            })
+        );
+        assert!(d.busy(), "servo 4's read is still in flight");
+        assert_eq!(d.on_packet(status(3, &[0, 8])), None, "taken once");
+    }
+
+    #[test]
+    fn a_late_answer_is_not_taken_after_its_window_or_a_new_instruction_to_its_servo() {
+        const DEADLINE_US: u64 = 350;
+        let mut d = ServoDriver::new(150);
+        timed_out(&mut d, 3);
+        d.poll(DEADLINE_US + LATE_ANSWER_WINDOW_US, &NullPort);
+        assert!(d.on_packet(status(3, &[0, 8])).is_some(), "at the window's end");
+        timed_out(&mut d, 3);
+        d.poll(DEADLINE_US + LATE_ANSWER_WINDOW_US + 1, &NullPort);
+        assert_eq!(d.on_packet(status(3, &[0, 8])), None, "too late");
+        timed_out(&mut d, 3);
+        let one_byte = Op::Read {
+            id: 3,
+            addr: 40,
+            count: 1,
+        };
+        start(&mut d, one_byte);
+        assert_eq!(
+            d.on_packet(status(3, &[0, 8])),
+            None,
+            "servo 3 was asked something else since"
+        );
+    }
+
+    #[test]
+    fn a_write_that_got_no_answer_waits_for_none() {
+        let mut d = ServoDriver::new(150);
+        start(&mut d, Op::write(2, 40, &[1]).unwrap());
+        assert_eq!(
+            d.poll(1_000, &NullPort).map(|(_, o)| o),
+            Some(Outcome::Sent)
+        );
+        assert_eq!(d.on_packet(status(2, &[])), None);
     }
 
     #[test]

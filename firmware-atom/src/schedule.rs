@@ -22,7 +22,7 @@ use protocol_core::timing::{
 use protocol_core::{BytePort, Frame};
 
 use crate::bank::ServoBank;
-use crate::driver::{Op, Outcome, ServoDriver};
+use crate::driver::{Op, Outcome, ServoDriver, Taken};
 use crate::settings::Settings;
 
 /// How long after its last byte a frame equal to our last bus reply is taken for its echo.
@@ -151,9 +151,9 @@ impl BusSchedule {
         self.reply = Some(reply);
     }
 
-    /// Offers a received servo packet to the transaction in flight; returns the transaction
-    /// it finished.
-    pub fn on_packet(&mut self, packet: Packet) -> Option<(Op, Outcome)> {
+    /// Offers a received servo packet to the transaction in flight, or as the late answer to
+    /// a READ that timed out ([`ServoDriver::on_packet`]).
+    pub fn on_packet(&mut self, packet: Packet) -> Option<Taken> {
         self.driver.on_packet(packet)
     }
 
