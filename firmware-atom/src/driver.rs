@@ -117,17 +117,15 @@ struct InFlight {
     deadline_us: u64,
 }
 
-/// How long after its deadline the answer to a READ is still taken, if it comes whole: a servo
-/// that answers late (its return delay, a busy servo) or an answer held up on its way (an
-/// emulated board's socket) is still the servo's state, read after the instruction went out.
-/// On a real bus the Atom does not start its next instruction while another station's bytes are
-/// on the wire, so a late answer under way arrives whole; one that meets the next instruction
-/// arrives garbled and is not taken. Shorter than the bank's read slack (10 ms), so a late
-/// answer never makes a reading look staler or faster than it is.
+/// How long after its deadline the answer to a READ is still awaited and taken, if it comes
+/// whole: a servo that answers late (its return delay, a busy servo) or an answer held up on
+/// its way (an emulated board's socket) is still the servo's state, read after the instruction
+/// went out. Meanwhile the Atom starts nothing on the wire (the driver stays busy), so a late
+/// answer never meets the Atom's next instruction, and an answer is never taken for a later
+/// question. A servo that does not answer at all costs its round this much more; a lost servo
+/// is read only every 8th round. Shorter than the bank's read slack (10 ms), so an answer dated
+/// when it was asked never looks faster than the servo can turn.
 pub const LATE_ANSWER_WINDOW_US: u64 = 5_000;
-
-/// Most timed-out READs whose answers are still awaited at once.
-const OVERDUE_MAX: usize = 4;
 
 /// A READ that timed out, whose answer is taken until `until_us` if it comes whole.
 #[derive(Clone, Debug)]
@@ -159,8 +157,8 @@ pub enum Taken {
 #[derive(Clone, Debug, Default)]
 pub struct ServoDriver {
     in_flight: Option<InFlight>,
-    /// READs that timed out lately, oldest first.
-    overdue: Vec<Overdue, OVERDUE_MAX>,
+    /// The READ that timed out last, while its answer is still awaited.
+    overdue: Option<Overdue>,
     reply_margin_us: u64,
 }
 
@@ -169,14 +167,15 @@ impl ServoDriver {
     pub fn new(reply_margin_us: u64) -> Self {
         Self {
             in_flight: None,
-            overdue: Vec::new(),
+            overdue: None,
             reply_margin_us,
         }
     }
 
-    /// True while a transaction is in flight.
+    /// True while a transaction is in flight, or the answer to a READ that timed out is still
+    /// awaited ([`LATE_ANSWER_WINDOW_US`]).
     pub fn busy(&self) -> bool {
-        self.in_flight.is_some()
+        self.in_flight.is_some() || self.overdue.is_some()
     }
 
     /// Sends `op`'s instruction at `now_us`. `false` (and nothing sent) if a transaction is
@@ -194,8 +193,6 @@ impl ServoDriver {
         let Some(packet) = op.packet() else {
             return false;
         };
-        // A new instruction to the same servo: an answer to an older one is no longer taken.
-        self.overdue.retain(|o| o.op.id() != op.id());
         let bytes = packet.to_bytes();
         bus.write(&bytes);
         rx.on_transmit(now_us, &bytes);
@@ -224,8 +221,7 @@ impl ServoDriver {
             let flight = self.in_flight.take()?;
             return Some(Taken::Finished(flight.op, Outcome::Answered(packet)));
         }
-        let late = self.overdue.iter().position(|o| answers(&o.op, &packet))?;
-        let overdue = self.overdue.remove(late);
+        let overdue = self.overdue.take_if(|o| answers(&o.op, &packet))?;
         Some(Taken::Late {
             op: overdue.op,
             answer: packet,
@@ -236,7 +232,7 @@ impl ServoDriver {
     /// Ends the transaction in flight if its time is up: a broadcast once it has left the
     /// transmitter, an answerable one at its deadline.
     pub fn poll<B: BytePort>(&mut self, now_us: u64, bus: &B) -> Option<(Op, Outcome)> {
-        self.overdue.retain(|o| now_us <= o.until_us);
+        self.overdue.take_if(|o| now_us > o.until_us);
         let flight = self.in_flight.as_ref()?;
         let done = match flight.op.answer_data_len() {
             None => bus.tx_idle() || now_us >= flight.deadline_us,
@@ -251,14 +247,12 @@ impl ServoDriver {
         } else {
             Outcome::Sent
         };
-        if matches!(flight.op, Op::Read { .. }) {
-            if self.overdue.is_full() {
-                self.overdue.remove(0);
-            }
-            let _ = self.overdue.push(Overdue {
+        let until_us = flight.deadline_us.saturating_add(LATE_ANSWER_WINDOW_US);
+        if matches!(flight.op, Op::Read { .. }) && now_us <= until_us {
+            self.overdue = Some(Overdue {
                 op: flight.op.clone(),
                 sent_us: flight.sent_us,
-                until_us: flight.deadline_us.saturating_add(LATE_ANSWER_WINDOW_US),
+                until_us,
             });
         }
         Some((flight.op, outcome))
@@ -336,8 +330,9 @@ mod tests {
     fn a_late_answer_that_comes_whole_is_taken_with_the_time_its_read_was_sent() {
         let mut d = ServoDriver::new(150);
         timed_out(&mut d, 3);
-        // The next transaction is under way when the late answer comes.
-        start(&mut d, read(4));
+        assert!(d.busy(), "the wire stays the servo's for its late answer");
+        assert!(!d.start(0, read(4), &mut NullPort, &mut Listener::default()));
+        assert_eq!(d.on_packet(status(4, &[0, 8])), None, "another servo");
         assert_eq!(d.on_packet(status(3, &[0])), None, "short answer");
         assert_eq!(
             d.on_packet(status(3, &[0, 8])),
@@ -347,32 +342,22 @@ mod tests {
                 sent_us: 0,
             })
         );
-        assert!(d.busy(), "servo 4's read is still in flight");
+        assert!(!d.busy(), "taken: the wire is free");
         assert_eq!(d.on_packet(status(3, &[0, 8])), None, "taken once");
     }
 
     #[test]
-    fn a_late_answer_is_not_taken_after_its_window_or_a_new_instruction_to_its_servo() {
+    fn a_late_answer_is_awaited_until_its_window_ends_and_not_taken_after() {
         const DEADLINE_US: u64 = 350;
         let mut d = ServoDriver::new(150);
         timed_out(&mut d, 3);
         d.poll(DEADLINE_US + LATE_ANSWER_WINDOW_US, &NullPort);
+        assert!(d.busy());
         assert!(d.on_packet(status(3, &[0, 8])).is_some(), "at the window's end");
         timed_out(&mut d, 3);
         d.poll(DEADLINE_US + LATE_ANSWER_WINDOW_US + 1, &NullPort);
+        assert!(!d.busy(), "given up: the wire is free");
         assert_eq!(d.on_packet(status(3, &[0, 8])), None, "too late");
-        timed_out(&mut d, 3);
-        let one_byte = Op::Read {
-            id: 3,
-            addr: 40,
-            count: 1,
-        };
-        start(&mut d, one_byte);
-        assert_eq!(
-            d.on_packet(status(3, &[0, 8])),
-            None,
-            "servo 3 was asked something else since"
-        );
     }
 
     #[test]
