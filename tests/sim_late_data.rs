@@ -338,7 +338,10 @@ fn a_joint_answering_late_but_whole_is_followed_to_the_target() {
     set_faults(&mut robot, 5, Faults::late_replies(400));
     wait_until_stopped(&mut robot);
     let at = robot.shaft_angles_deg();
-    assert!((at[0] - 90.0).abs() < 0.2 && (at[4] - 90.0).abs() < 0.2, "{at:?}");
+    assert!(
+        (at[0] - 90.0).abs() < 0.2 && (at[4] - 90.0).abs() < 0.2,
+        "{at:?}"
+    );
     assert_eq!(ask(&mut robot, Request::GetErrorInfo), Reply::Byte(0));
 }
 
@@ -363,7 +366,10 @@ fn is_moving_stays_1_while_a_joint_is_not_read() {
     set_faults(&mut robot, 4, Faults::dropped_replies(1000));
     for _ in 0..10 {
         robot.run_for(100_000);
-        assert!(is_moving(&mut robot), "joint 4 unread during a move, yet at rest?");
+        assert!(
+            is_moving(&mut robot),
+            "joint 4 unread during a move, yet at rest?"
+        );
     }
 }
 

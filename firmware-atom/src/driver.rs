@@ -323,7 +323,10 @@ mod tests {
     /// turnaround, 80 us back, 150 us margin).
     fn timed_out(d: &mut ServoDriver, id: u8) {
         start(d, read(id));
-        assert_eq!(d.poll(1_000, &NullPort), Some((read(id), Outcome::TimedOut)));
+        assert_eq!(
+            d.poll(1_000, &NullPort),
+            Some((read(id), Outcome::TimedOut))
+        );
     }
 
     #[test]
@@ -353,7 +356,10 @@ mod tests {
         timed_out(&mut d, 3);
         d.poll(DEADLINE_US + LATE_ANSWER_WINDOW_US, &NullPort);
         assert!(d.busy());
-        assert!(d.on_packet(status(3, &[0, 8])).is_some(), "at the window's end");
+        assert!(
+            d.on_packet(status(3, &[0, 8])).is_some(),
+            "at the window's end"
+        );
         timed_out(&mut d, 3);
         d.poll(DEADLINE_US + LATE_ANSWER_WINDOW_US + 1, &NullPort);
         assert!(!d.busy(), "given up: the wire is free");

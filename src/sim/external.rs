@@ -6,6 +6,15 @@
 //!   gap. The gate holds bytes until they make a whole frame (a host frame `FE FE LEN ...` or a
 //!   servo packet `FF FF ID LEN ...`) and lets it onto the wire in one piece; bytes that make
 //!   no frame pass once nothing more has come for [`STALE_AFTER_NS`].
+//! * The other way, the same: what a board hears is handed to its socket a whole frame or
+//!   packet at a time. The loop that writes the sockets runs on a tick, and a servo answer
+//!   handed over as its bytes come off the wire went in two or three chunks; the emulator
+//!   passes each chunk to the UART at the baud rate, but a late chunk left a gap inside the
+//!   answer, and the firmware cuts a servo packet short after 40 us of silence
+//!   (`BUS_PACKET_GAP_US`): the answer was dropped as a fragment. On a real wire a packet's
+//!   bytes come back to back. (Found on the emulated C3 Atom: 18 % of its state reads got no
+//!   answer it could take, with every answer whole on the simulated wire and no checksum
+//!   error.)
 //! * [`EmulatedArm`]: the simulated bus and seven servos with external boards attached. Each
 //!   hears every other station's bytes, but not its own: on the real boards TX and RX are tied
 //!   and the echo ends 30 us after the byte at the latest ([`ECHO_GRACE_US`]), which no echo
@@ -150,8 +159,8 @@ struct ExternalBoard {
     /// Silence its frames wait for on the wire, in ns (see the [module doc](self)).
     quiet_before_send_ns: u64,
     gate: FrameGate,
-    /// What the board's UART receives, waiting to be taken.
-    heard: Vec<u8>,
+    /// What the board's UART receives, held until it makes a whole frame or packet.
+    received: FrameGate,
 }
 
 /// The simulated bus and servos serving boards that run elsewhere. See the [module doc](self).
@@ -199,7 +208,7 @@ impl EmulatedArm {
             station,
             quiet_before_send_ns: quiet_before_send_us.saturating_mul(1_000),
             gate: FrameGate::new(),
-            heard: Vec::new(),
+            received: FrameGate::new(),
         });
         BoardId(self.boards.len() - 1)
     }
@@ -254,10 +263,17 @@ impl EmulatedArm {
         }
     }
 
-    /// Appends to `out` what `board`'s bus UART received so far.
+    /// Appends to `out` what `board`'s bus UART received so far, in whole frames and packets
+    /// (bytes that make none once nothing more came for [`STALE_AFTER_NS`]).
     pub fn board_received(&mut self, board: BoardId, out: &mut Vec<u8>) {
         if let Some(b) = self.boards.get_mut(board.0) {
-            out.append(&mut b.heard);
+            loop {
+                let before = out.len();
+                b.received.release(self.now_ns, out);
+                if out.len() == before {
+                    break;
+                }
+            }
         }
     }
 
@@ -265,7 +281,10 @@ impl EmulatedArm {
     pub fn busy(&self) -> bool {
         self.bus.busy()
             || self.servos.next_event_ns().is_some()
-            || self.boards.iter().any(|b| b.gate.holds())
+            || self
+                .boards
+                .iter()
+                .any(|b| b.gate.holds() || b.received.holds())
     }
 
     /// Advances virtual time to `t_us`.
@@ -318,9 +337,11 @@ impl EmulatedArm {
             let Some(mut port) = self.bus.port(board.station) else {
                 continue;
             };
+            self.frame.clear();
             while let Some(byte) = port.read_byte() {
-                board.heard.push(byte);
+                self.frame.push(byte);
             }
+            board.received.push(now_ns, &self.frame);
             if line_free {
                 self.frame.clear();
                 board.gate.release(now_ns, &mut self.frame);
@@ -392,6 +413,26 @@ mod tests {
         assert_eq!(heard.get(5..7), Some(&[0x00, 0x08][..]), "position 2048");
         assert_eq!(heard.len(), 8, "the answer alone: {heard:02X?}");
         assert!(!arm.busy());
+    }
+
+    #[test]
+    fn a_board_hears_a_servo_answer_in_one_piece_however_often_it_is_asked() {
+        let mut arm = EmulatedArm::new(1, 2048);
+        let atom = arm.attach_board(0);
+        arm.run_until(100);
+        // READ servo 1's state (0x28, 31 bytes): a 37-byte answer, 370 us on the wire.
+        arm.board_sent(atom, 100, &[0xFF, 0xFF, 0x01, 0x04, 0x02, 0x28, 0x1F, 0xB1]);
+        let mut chunks = Vec::new();
+        for t in (150..2_000).step_by(50) {
+            arm.run_until(t);
+            let mut heard = Vec::new();
+            arm.board_received(atom, &mut heard);
+            if !heard.is_empty() {
+                chunks.push(heard);
+            }
+        }
+        assert_eq!(chunks.len(), 1, "in pieces: {chunks:02X?}");
+        assert_eq!(chunks.first().map(Vec::len), Some(37));
     }
 
     #[test]
