@@ -100,6 +100,11 @@ class Seed(unittest.TestCase):
         self.assertEqual(self.ask(frame(0x50)), [1], "check connection")
         self.assertEqual(self.ask(frame(0xC5)), [2])
 
+    @unittest.skip(
+        "a move through the whole emulated arm: on two cores its servo answers come too late "
+        "(docs/boards.md, 'Servo answers miss the Atom's deadline', item 4); the virtual robot "
+        "runs this (tests/sim_seed_manual.rs)"
+    )
     def test_joint_0_is_the_first_joint_and_0x28_stops(self):
         self.move_joint_1(0, 50)
         self.wait_still()

@@ -14,7 +14,7 @@ pub struct BoardIo<'d> {
     inputs: [Input<'d>; 2],
     /// Buttons A, B, C.
     buttons: [Input<'d>; 3],
-    /// The Wi-Fi settings' flash ([`crate::network::SETTINGS_FLASH`] through esp-storage).
+    /// The Wi-Fi settings' flash (its region, through esp-storage).
     #[cfg(feature = "wifi")]
     wifi: Option<FlashWifiStore<esp_storage::FlashStorage<'d>>>,
 }
@@ -37,10 +37,14 @@ impl<'d> BoardIo<'d> {
         }
     }
 
-    /// Lends the Basic `flash` for its Wi-Fi settings, from boot on.
+    /// Lends the Basic `region` of `flash` for its Wi-Fi settings, from boot on.
     #[cfg(feature = "wifi")]
-    pub fn with_wifi_flash(mut self, flash: esp_storage::FlashStorage<'d>) -> Self {
-        self.wifi = Some(FlashWifiStore::new(flash, crate::network::SETTINGS_FLASH));
+    pub fn with_wifi_flash(
+        mut self,
+        flash: esp_storage::FlashStorage<'d>,
+        region: core::ops::Range<u32>,
+    ) -> Self {
+        self.wifi = Some(FlashWifiStore::new(flash, region));
         self
     }
 }

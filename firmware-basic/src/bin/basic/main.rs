@@ -144,7 +144,10 @@ fn run() -> ! {
     let io = BoardIo::new(pins.outputs, pins.inputs, pins.buttons);
     // The Wi-Fi settings: answered over 0xB0..0xB2 on every link, even if the radio fails.
     #[cfg(feature = "wifi")]
-    let io = io.with_wifi_flash(esp_storage::FlashStorage::new(p.FLASH));
+    let io = io.with_wifi_flash(
+        esp_storage::FlashStorage::new(p.FLASH),
+        network::SETTINGS_FLASH,
+    );
     let mut io = io;
 
     let mut basic = Basic::new(BasicConfig::default());
