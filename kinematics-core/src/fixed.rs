@@ -233,6 +233,72 @@ pub fn ratio(num: i64, den: i64) -> i64 {
     num.checked_div(den).unwrap_or(0)
 }
 
+/// `a / b` for `i128`, rounded towards zero like `/`; `None` for `b` = 0 and for `i128::MIN /
+/// -1` (like `checked_div`).
+///
+/// Written out (shift and subtract, or one `u64` division when both fit) because on the ESP32
+/// the compiler's own `i128` division is wrong: LLVM's Xtensa backend calls compiler_builtins'
+/// `__divti3` / `__udivti3` with the two `i128` arguments where the Rust-compiled routine does
+/// not look for them, so 1 000 000 007 / 7 gives 0 and some divisions never return
+/// (docs/boards.md, "128-bit division on the ESP32"). `.ci/link-esp32` fails an image that
+/// links either routine; use this instead of `/`, `%` or `checked_div` on `i128` or `u128`.
+pub fn checked_div_i128(a: i128, b: i128) -> Option<i128> {
+    if b == 0 || (a == i128::MIN && b == -1) {
+        return None;
+    }
+    let q = div_u128(a.unsigned_abs(), b.unsigned_abs());
+    // q <= 2^127; negated it fits (2^127 is i128::MIN), and a positive q is below 2^127 since
+    // only i128::MIN / -1 would reach it.
+    Some(if (a < 0) != (b < 0) {
+        0u128.wrapping_sub(q) as i128
+    } else {
+        q as i128
+    })
+}
+
+/// `n / d` for `d` > 0, without the compiler's 128-bit division (see [`checked_div_i128`]).
+fn div_u128(n: u128, d: u128) -> u128 {
+    if d == 0 || d > n {
+        return 0;
+    }
+    if let (Ok(n), Ok(d)) = (u64::try_from(n), u64::try_from(d)) {
+        return u128::from(n.checked_div(d).unwrap_or(0));
+    }
+    // Long division, one quotient bit per step from the highest that can be set.
+    let shift = d.leading_zeros() - n.leading_zeros();
+    let (mut d, mut rest, mut q) = (d << shift, n, 0u128);
+    for _ in 0..=shift {
+        q <<= 1;
+        if rest >= d {
+            rest -= d;
+            q |= 1;
+        }
+        d >>= 1;
+    }
+    q
+}
+
+/// Square root of `n`, rounded down, digit by digit: shifts, compares and subtractions only
+/// (`u128::isqrt` divides, with the compiler's 128-bit division: see [`checked_div_i128`]).
+pub fn isqrt_u128(n: u128) -> u128 {
+    if n == 0 {
+        return 0;
+    }
+    // The highest power of 4 not above n.
+    let mut bit = 1u128 << ((127 - n.leading_zeros()) & !1);
+    let (mut rest, mut root) = (n, 0u128);
+    while bit != 0 {
+        if rest >= root + bit {
+            rest -= root + bit;
+            root = (root >> 1) + bit;
+        } else {
+            root >>= 1;
+        }
+        bit >>= 2;
+    }
+    root
+}
+
 /// Right shift that leaves the top eight bits of a normalised [`sqrt`] argument (in
 /// [2^61, 2^63)) as the index into [`SQRT_SEEDS`].
 const SQRT_SEED_SHIFT: u32 = 55;
@@ -289,6 +355,69 @@ pub fn sqrt(v: i64) -> i64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn division_of_i128_written_out_matches_the_operator() {
+        let cases: [(i128, i128); 12] = [
+            (1_000_000_007, 7),
+            (-412_703_666_745_104_000_000_000, 3),
+            (-412_703_666_745_104_000_000_000, 5_000_000_000),
+            (-412_703_666_745_104_000_000_000, 21_768_192_896_800_000_000),
+            (i128::MAX, 340_282_366_920_938_463_463),
+            (1_000_000_000_000_000_000_000, -18_446_744_073_709_551_617),
+            (i128::MIN, 1),
+            (i128::MIN, 2),
+            (i128::MIN, i128::MIN),
+            (i128::MAX, i128::MIN),
+            (5, 7),
+            (-7, 7),
+        ];
+        for (a, b) in cases {
+            assert_eq!(checked_div_i128(a, b), a.checked_div(b), "{a} / {b}");
+        }
+        assert_eq!(checked_div_i128(1, 0), None);
+        assert_eq!(checked_div_i128(i128::MIN, -1), None);
+        for n in [
+            0,
+            1,
+            2,
+            3,
+            4,
+            15,
+            16,
+            17,
+            u128::from(u64::MAX),
+            u128::MAX,
+            u128::MAX >> 1,
+        ] {
+            assert_eq!(isqrt_u128(n), n.isqrt(), "sqrt {n}");
+        }
+    }
+
+    proptest::proptest! {
+        /// Every magnitude of dividend and divisor, each a random value shifted right by a
+        /// random amount.
+        #[test]
+        fn division_of_i128_written_out_matches_the_operator_everywhere(
+            a in proptest::prelude::any::<i128>(),
+            b in proptest::prelude::any::<i128>(),
+            a_shift in 0u32..128,
+            b_shift in 0u32..128,
+        ) {
+            let (a, b) = (a >> a_shift, b >> b_shift);
+            proptest::prop_assert_eq!(checked_div_i128(a, b), a.checked_div(b));
+        }
+
+        /// Every magnitude.
+        #[test]
+        fn square_root_of_u128_written_out_matches_isqrt(
+            n in proptest::prelude::any::<u128>(),
+            shift in 0u32..128,
+        ) {
+            let n = n >> shift;
+            proptest::prop_assert_eq!(isqrt_u128(n), n.isqrt());
+        }
+    }
 
     fn to_rad(a: Angle) -> f64 {
         a.0 as f64 * core::f64::consts::TAU / 4_294_967_296.0

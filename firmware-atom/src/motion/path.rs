@@ -7,6 +7,7 @@
 //! them one period later. Where joints would have to move faster than the speed allows (next to
 //! a singularity), the walker takes a shorter step and the path slows there.
 
+use kinematics_core::fixed::checked_div_i128;
 use kinematics_core::{Arc, Kinematics, Line, Path, PathError, PathWalker, Ray, Transform, Turn};
 use protocol_core::command::Pose;
 use protocol_core::units::Centideg;
@@ -354,7 +355,8 @@ fn pose_error(a: &Transform, b: &Transform) -> i128 {
         .sum();
     // Internal lengths: 16 000 per mm; rotation entries: 2^30 per unit, a degree = 0.0175.
     // (16 000 / (0.0175 * 2^30))^2 = 1 / 1 370 000 scales a degree to a millimetre.
-    position + rotation / 1_370_000
+    // Not `/`: the compiler's 128-bit division is wrong on the ESP32 (checked_div_i128).
+    position + checked_div_i128(rotation, 1_370_000).unwrap_or(0)
 }
 
 #[cfg(test)]

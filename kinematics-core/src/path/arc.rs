@@ -10,7 +10,7 @@
 //! the end); t is a binary angle (2^32 per turn). Rounding keeps every point within a micrometre
 //! of the exact circle (tests compare with f64 geometry).
 
-use crate::fixed::{Angle, ONE, atan2, mul, ratio, sqrt};
+use crate::fixed::{Angle, ONE, atan2, checked_div_i128, isqrt_u128, mul, ratio, sqrt};
 use crate::transform::{LEN_PER_TENTH_MM, Rotation, Transform};
 
 use super::{Path, UM_PER_CENTIDEG};
@@ -149,7 +149,7 @@ impl Arc {
         let den = w2.checked_mul(2)?;
         let mut centre = p0;
         for (c, n) in centre.iter_mut().zip(offset_num) {
-            let scaled = n.checked_mul(i128::from(LEN_PER_UM))?.checked_div(den)?;
+            let scaled = checked_div_i128(n.checked_mul(i128::from(LEN_PER_UM))?, den)?;
             *c = c.checked_add(i64::try_from(scaled).ok()?)?;
         }
         let [s0, s1, s2] = [0, 1, 2].map(|i| {
@@ -171,7 +171,7 @@ impl Arc {
         let w_len = isqrt_i128(w2);
         let n = [0, 1, 2].map(|i| {
             let wi = w.get(i).copied().unwrap_or(0);
-            i64::try_from(wi.checked_mul(i128::from(ONE))?.checked_div(w_len)?).ok()
+            i64::try_from(checked_div_i128(wi.checked_mul(i128::from(ONE))?, w_len)?).ok()
         });
         let [n0, n1, n2] = n;
         let [n0, n1, n2] = [n0?, n1?, n2?];
@@ -285,7 +285,7 @@ fn isqrt_i128(v: i128) -> i128 {
     if v <= 0 {
         0
     } else {
-        v.unsigned_abs().isqrt() as i128
+        isqrt_u128(v.unsigned_abs()) as i128
     }
 }
 
