@@ -11,6 +11,9 @@
 //! tools/emulate's choice, so the test and a person running tools/emulate see the same one:
 //! `esp32-picsimlab` where the ESP32 emulator has it (PICSimLab's fork), else `esp32`
 //! (`ESP_QEMU_MACHINE_ESP32` overrides it); `esp32c3` for the C3.
+//!
+//! `atom_loop_passes_on_the_emulated_esp32`: the cost of the Atom's loop passes on the ESP32,
+//! in instructions, against their budgets (docs/boards.md, "Loop passes on the chip").
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
 use std::io::{BufRead, BufReader, Write};
@@ -203,4 +206,196 @@ fn pymycobot_subset_on_the_emulated_images() {
         failed.is_empty(),
         "failed on the emulated images: {failed:?}"
     );
+}
+
+/// `-icount` shift of the pass-cost run: every emulated instruction takes 2^2 = 4 ns of the
+/// emulated chip's time, about a 240 MHz chip's cycle, so the loop's timing stays realistic.
+const ICOUNT_SHIFT: u32 = 2;
+/// Longest the pass-cost image may run (about 75 s on a quiet machine).
+const STEPS_DEADLINE: Duration = Duration::from_secs(600);
+/// Cycles an instruction is allowed at 240 MHz when a budget in time becomes one in
+/// instructions: the LX6 issues at most one a cycle; the rest is room for flash-cache misses.
+const CYCLES_PER_INSTRUCTION: u64 = 3; // over 2: 1.5 cycles
+/// The ESP32's clock, MHz.
+const CHIP_MHZ: u64 = 240;
+
+/// Instructions a pass may take to stay within `us` at 240 MHz, 1.5 cycles each.
+const fn budget(us: u64) -> u64 {
+    us * CHIP_MHZ * 2 / CYCLES_PER_INSTRUCTION
+}
+/// The pass that takes a command (and plans its motion): the bus is quiet then (the Basic
+/// forwards in the Atom's gap, with no servo transaction under way), so the deadline is that
+/// of the motion under way, whose next point is due within its 20 ms period: half of it.
+const COMMAND_PASS_BUDGET: u64 = budget(10_000);
+/// Every other pass: a servo answer that comes during it is still taken up to 5 ms after its
+/// deadline (the Atom's late-answer window), and fits the UART's 128-byte FIFO.
+const OTHER_PASS_BUDGET: u64 = budget(5_000);
+/// The bus's reply margin (150 us): a pass within it never needs the late-answer window.
+const REPLY_MARGIN_BUDGET: u64 = budget(150);
+
+/// One step of the pass-cost image's report.
+#[derive(Debug)]
+struct StepCost {
+    name: String,
+    passes: u64,
+    first_cycles: u64,
+    other_cycles: u64,
+    reply: String,
+    error: String,
+}
+
+/// Parses `step NAME: passes P, first F cycles, longest other L cycles (pass K), mean M,
+/// reply [..], error E`.
+fn step_cost(line: &str) -> Option<StepCost> {
+    let (name, rest) = line.strip_prefix("step ")?.split_once(": ")?;
+    let number = |key: &str| -> Option<u64> {
+        let at = rest.find(key)? + key.len();
+        rest[at..]
+            .split(|c: char| !c.is_ascii_digit())
+            .next()?
+            .parse()
+            .ok()
+    };
+    let reply = rest.split("reply ").nth(1)?.split(", error").next()?;
+    Some(StepCost {
+        name: name.to_string(),
+        passes: number("passes ")?,
+        first_cycles: number("first ")?,
+        other_cycles: number("longest other ")?,
+        reply: reply.to_string(),
+        error: rest.rsplit("error ").next()?.trim().to_string(),
+    })
+}
+
+/// The Atom's loop on the emulated ESP32, pass by pass (firmware-atom's `atom-steps` image:
+/// the real loop against servos inside the image): every step answered as on the host, and
+/// each pass within its budget in instructions (docs/boards.md, "Loop passes on the chip").
+#[test]
+fn atom_loop_passes_on_the_emulated_esp32() {
+    let Some(qemu) = std::env::var_os("ESP_QEMU_XTENSA").filter(|v| !v.is_empty()) else {
+        say("emulated passes: skipped, ESP_QEMU_XTENSA is not set (no ESP32 emulator here)");
+        return;
+    };
+    let root = workspace();
+    let link = Command::new(root.join(".ci/link-esp32"))
+        .args(["--only", "atom-steps"])
+        .current_dir(&root)
+        .output()
+        .expect("run .ci/link-esp32");
+    assert!(
+        link.status.success(),
+        ".ci/link-esp32 --only atom-steps failed:\n{}",
+        String::from_utf8_lossy(&link.stdout)
+    );
+    let work = std::env::temp_dir().join(format!("open-mycobot-steps-{}", std::process::id()));
+    std::fs::create_dir_all(&work).unwrap();
+    let flash = work.join("flash.bin");
+    std::fs::copy(
+        root.join("target/esp32-images/atom-steps-merged.bin"),
+        &flash,
+    )
+    .unwrap();
+    let efuse = work.join("efuse.bin");
+    let made = Command::new(root.join("tools/qemu-efuse"))
+        .arg("esp32")
+        .arg(&efuse)
+        .status()
+        .unwrap();
+    assert!(made.success(), "tools/qemu-efuse failed");
+    let machines = Command::new(&qemu)
+        .args(["-machine", "help"])
+        .output()
+        .unwrap();
+    let machine = std::env::var("ESP_QEMU_MACHINE_ESP32").unwrap_or_else(|_| {
+        let list = String::from_utf8_lossy(&machines.stdout);
+        if list.lines().any(|l| l.starts_with("esp32-picsimlab ")) {
+            "esp32-picsimlab".into()
+        } else {
+            "esp32".into()
+        }
+    });
+    let uart0 = work.join("uart0.txt");
+    let mut emulator = Command::new(&qemu)
+        .args(["-nographic", "-machine", &machine, "-monitor", "none"])
+        .args(["-icount", &format!("shift={ICOUNT_SHIFT}")])
+        .arg("-drive")
+        .arg(format!("file={},if=mtd,format=raw", flash.display()))
+        .arg("-drive")
+        .arg(format!(
+            "file={},if=none,format=raw,id=efuse",
+            efuse.display()
+        ))
+        .args([
+            "-global",
+            "driver=nvram.esp32.efuse,property=drive,value=efuse",
+        ])
+        .arg("-serial")
+        .arg(format!("file:{}", uart0.display()))
+        .args(["-serial", "null"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("start the ESP32 emulator");
+    let deadline = Instant::now() + STEPS_DEADLINE;
+    let report = loop {
+        let text = std::fs::read_to_string(&uart0).unwrap_or_default();
+        if text.contains("atom-steps: done") || Instant::now() > deadline {
+            break text;
+        }
+        thread::sleep(Duration::from_millis(500));
+    };
+    let _ = emulator.kill();
+    let _ = emulator.wait();
+    let _ = std::fs::remove_dir_all(&work);
+    assert!(
+        report.contains("atom-steps: done"),
+        "the pass-cost image did not finish in {STEPS_DEADLINE:?}:\n{report}"
+    );
+
+    // Cycles per microsecond of the emulated chip's time; an instruction takes 2^shift ns.
+    let clock = report
+        .lines()
+        .find_map(|l| l.strip_prefix("clock: "))
+        .expect("a clock line");
+    let numbers: Vec<f64> = clock
+        .split(|c: char| !c.is_ascii_digit())
+        .filter_map(|n| n.parse().ok())
+        .collect();
+    let cycles_per_instruction = numbers[0] / numbers[1] * f64::from(1u32 << ICOUNT_SHIFT) / 1000.0;
+    let instructions = |cycles: u64| (cycles as f64 / cycles_per_instruction).round() as u64;
+
+    let steps: Vec<StepCost> = report.lines().filter_map(step_cost).collect();
+    assert_eq!(steps.len(), 11, "every step reported:\n{report}");
+    say(&format!(
+        "== the Atom's loop passes on the emulated ESP32 ({machine}, -icount shift={ICOUNT_SHIFT}), instructions (budget: command {COMMAND_PASS_BUDGET}, other {OTHER_PASS_BUDGET}; the reply margin is {REPLY_MARGIN_BUDGET})"
+    ));
+    let mut over = Vec::new();
+    for step in &steps {
+        let (first, other) = (
+            instructions(step.first_cycles),
+            instructions(step.other_cycles),
+        );
+        let margin = if first.max(other) <= REPLY_MARGIN_BUDGET {
+            "within the reply margin"
+        } else {
+            "past the reply margin"
+        };
+        say(&format!(
+            "   {:<24} {:>7} passes, command pass {:>9}, longest other {:>9}: {margin}, reply {}, error {}",
+            step.name, step.passes, first, other, step.reply, step.error
+        ));
+        if first > COMMAND_PASS_BUDGET || other > OTHER_PASS_BUDGET {
+            over.push(step.name.clone());
+        }
+        assert_eq!(step.error, "0", "{} left error {}", step.name, step.error);
+        if step.name != "idle" {
+            assert!(
+                step.reply != "[]" && step.reply != "[00]",
+                "{} answered {}",
+                step.name,
+                step.reply
+            );
+        }
+    }
+    assert!(over.is_empty(), "over their budget: {over:?}");
 }
