@@ -18,6 +18,8 @@ compile_error!(
 );
 
 // The board layer is the Basic's; the teach image uses part of its screen text.
+#[path = "../basic/board.rs"]
+mod board;
 #[path = "../basic/board_io.rs"]
 mod board_io;
 #[path = "../basic/loop_time.rs"]
@@ -34,42 +36,16 @@ mod screen;
 mod screen_text;
 mod teach_text;
 
-use embedded_graphics::{pixelcolor::Rgb565, prelude::*};
 use embedded_hal::digital::OutputPin;
-use embedded_hal_bus::spi::ExclusiveDevice;
-use esp_hal::{
-    clock::CpuClock,
-    delay::Delay,
-    gpio::{Level, Output, OutputConfig},
-    main,
-    spi::{
-        Mode,
-        master::{Config as SpiConfig, Spi},
-    },
-    time::Rate,
-    uart::Uart,
-};
+use esp_hal::{clock::CpuClock, main};
 use firmware_basic::teach::Teach;
 use firmware_basic::{BasicConfig, Programmed};
-use mipidsi::{
-    Builder,
-    interface::SpiInterface,
-    models::ILI9342CRgb565,
-    options::{ColorInversion, ColorOrder},
-};
 use protocol_core::timing::{BUS_BAUD, HOST_BAUD};
 
-use crate::{
-    board_io::BoardIo, loop_time::LoopTime, screen::StatusScreen, screen_text::BoardStatus,
-};
-use board_support::{LoopWatchdog, UartPort, board_log, now_us};
+use crate::{board_io::BoardIo, loop_time::LoopTime, screen_text::BoardStatus};
+use board_support::{LoopWatchdog, board_log, now_us};
 
 esp_bootloader_esp_idf::esp_app_desc!();
-
-/// LCD SPI clock: the ILI9342C's write limit on the M5Stack Basic.
-const LCD_SPI_MHZ: u32 = 40;
-/// Bytes mipidsi batches per SPI write.
-const LCD_BUFFER_BYTES: usize = 512;
 
 #[main]
 fn main() -> ! {
@@ -89,41 +65,18 @@ fn run() -> ! {
     let Ok(()) = OutputPin::set_low(&mut pins.speaker);
     board_log!("open-mycobot basic-teach {}", env!("CARGO_PKG_VERSION"));
 
-    let mut lcd_buffer = [0_u8; LCD_BUFFER_BYTES];
-    let spi_config = SpiConfig::default()
-        .with_frequency(Rate::from_mhz(LCD_SPI_MHZ))
-        .with_mode(Mode::_0);
-    let display = Spi::new(p.SPI2, spi_config).ok().and_then(|spi| {
-        let spi = spi.with_sck(pins.lcd_clk).with_mosi(pins.lcd_mosi);
-        let cs = Output::new(pins.lcd_cs, Level::High, OutputConfig::default());
-        let dc = Output::new(pins.lcd_dc, Level::Low, OutputConfig::default());
-        let device = ExclusiveDevice::new(spi, cs, Delay::new()).ok()?;
-        Builder::new(
-            ILI9342CRgb565,
-            SpiInterface::new(device, dc, &mut lcd_buffer),
-        )
-        .reset_pin(pins.lcd_reset)
-        .color_order(ColorOrder::Bgr)
-        .invert_colors(ColorInversion::Inverted)
-        .init(&mut Delay::new())
-        .ok()
-    });
-    let mut screen = display.and_then(|mut display| {
-        display.clear(Rgb565::BLACK).ok()?;
-        let Ok(()) = OutputPin::set_high(&mut pins.lcd_backlight);
-        Some(StatusScreen::new(display))
-    });
+    let mut lcd_buffer = [0_u8; board::LCD_BUFFER_BYTES];
+    let lcd = [pins.lcd_clk, pins.lcd_mosi, pins.lcd_cs, pins.lcd_dc];
+    let mut screen = board::status_screen(
+        p.SPI2,
+        lcd,
+        pins.lcd_reset,
+        &mut pins.lcd_backlight,
+        &mut lcd_buffer,
+    );
 
-    let host_uart = Uart::new(p.UART0, board_support::uart_port::config(HOST_BAUD))
-        .unwrap_or_else(|_| panic!("host UART configuration refused"))
-        .with_tx(pins.host_tx)
-        .with_rx(pins.host_rx);
-    let mut host = UartPort::new(host_uart, HOST_BAUD);
-    let bus_uart = Uart::new(p.UART1, board_support::uart_port::config(BUS_BAUD))
-        .unwrap_or_else(|_| panic!("bus UART configuration refused"))
-        .with_tx(pins.bus_tx)
-        .with_rx(pins.bus_rx);
-    let mut bus = UartPort::new(bus_uart, BUS_BAUD);
+    let mut host = board::uart_port(p.UART0, HOST_BAUD, pins.host_tx, pins.host_rx, "host");
+    let mut bus = board::uart_port(p.UART1, BUS_BAUD, pins.bus_tx, pins.bus_rx, "bus");
     let mut io = BoardIo::new(pins.outputs, pins.inputs, pins.buttons);
 
     // The program: the Basic's transponder with teach and play beside it.
