@@ -3,7 +3,8 @@
 
 mod common;
 
-use common::{BUS_BYTE_NS, Rig, frame};
+use common::{BUS_BYTE_NS, Rig, frame, pymycobot_reads};
+use firmware_basic::host_link::STREAM_FILLER;
 use firmware_basic::{AtomLink, BasicConfig, BasicError, EchoMode};
 use protocol_core::Frame;
 
@@ -496,12 +497,28 @@ fn a_garbled_reply_is_lost_and_the_request_never_sent_again() {
             rig.run_us(BasicConfig::default().reply_timeout_us + 10_000);
             let context = format!("byte {garbled}, echo {echo}");
             assert_eq!(rig.atom_got.len(), 1, "{context}");
-            assert!(rig.host.received().is_empty(), "{context}");
+            // With only the footer hit, the reply's start was passed on as it arrived
+            // (cut-through), and the rest of its place filled: no frame for any client.
+            let passed_on = if garbled == 5 {
+                vec![0xFE, 0xFE, 0x03, IS_POWERED_ON, 0x01, STREAM_FILLER]
+            } else {
+                Vec::new()
+            };
+            assert_eq!(rig.host.received(), passed_on, "{context}");
+            assert!(rig.host_frames().is_empty(), "{context}");
+            assert!(
+                pymycobot_reads(&rig.host.received()).is_empty(),
+                "{context}"
+            );
             // The client's resend is answered.
             rig.host.send(&frame(IS_POWERED_ON, &[]));
             rig.run_us(5_000);
             assert_eq!(rig.atom_got.len(), 2, "{context}");
-            assert_eq!(rig.host.received(), frame(IS_POWERED_ON, &[1]), "{context}");
+            let answer = frame(IS_POWERED_ON, &[1]);
+            assert!(rig.host.received().ends_with(&answer), "{context}");
+            let frames = rig.host_frames();
+            assert_eq!(frames.len(), 1, "{context}: {frames:?}");
+            assert_eq!(pymycobot_reads(&rig.host.received()), [answer], "{context}");
         }
     }
 }
@@ -622,6 +639,135 @@ fn a_request_in_the_atoms_gap_is_answered_while_it_polls_servos() {
                     "{case}: READ at {read} ns within the Atom's gap after the Basic's bytes"
                 );
             }
+        }
+    }
+}
+
+/// When the Atom's reply to the last request ended on the bus, ns.
+fn atom_reply_end_ns(rig: &Rig) -> u64 {
+    let (start, bytes) = rig.atom_sent.last().unwrap();
+    start + bytes.len() as u64 * BUS_BYTE_NS
+}
+
+#[test]
+fn a_reply_reaches_a_serial_client_before_it_has_ended_on_the_bus_and_without_a_gap() {
+    for echo in [true, false] {
+        let mut rig = Rig::quiet(echo);
+        rig.host.send(&frame(GET_ANGLES, &[]));
+        rig.run_us(5_000);
+        let reply = angles_reply();
+        assert_eq!(rig.host.received(), reply, "echo {echo}");
+        let starts: Vec<u64> = rig.host.from_basic.iter().map(|&(t, _)| t).collect();
+        let (bus_start, _) = rig.atom_sent[0];
+        // Its CMD (the fourth byte) is in at the start plus 4 byte times, and the poll after.
+        assert!(
+            starts[0] <= bus_start + 4 * BUS_BYTE_NS + rig.step_ns,
+            "echo {echo}: USB from {} ns, the reply on the bus from {bus_start} ns",
+            starts[0]
+        );
+        assert!(starts[0] < atom_reply_end_ns(&rig));
+        assert!(
+            starts
+                .windows(2)
+                .all(|w| w[1] - w[0] == common::HOST_BYTE_NS),
+            "echo {echo}: back to back on the wire: {starts:?}"
+        );
+    }
+}
+
+#[test]
+fn without_cut_through_a_reply_goes_once_it_has_ended_on_the_bus() {
+    let mut rig = Rig::new(
+        BasicConfig {
+            power_on_at_boot: false,
+            probe_interval_us: 0,
+            cut_through: false,
+            ..BasicConfig::default()
+        },
+        true,
+    );
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(5_000);
+    assert_eq!(rig.host.received(), angles_reply());
+    assert!(rig.host.from_basic[0].0 >= atom_reply_end_ns(&rig));
+}
+
+#[test]
+fn a_network_client_and_a_seed_client_get_each_reply_whole() {
+    let mut rig = Rig::quiet(true);
+    let net = rig.connect().unwrap();
+    rig.client(net).send(&frame(GET_ANGLES, &[]));
+    rig.run_us(5_000);
+    let client = rig.client(net);
+    assert_eq!(client.received(), angles_reply());
+    let first = client.from_basic[0].0;
+    assert!(
+        client.from_basic.iter().all(|&(t, _)| t == first),
+        "in one write: pymycobot's socket client takes one recv for the whole reply"
+    );
+    assert!(first >= atom_reply_end_ns(&rig));
+    // The seed dialect: its clients read frames of their own; replies go whole.
+    rig.host.send(&frame(0xC5, &[2]));
+    rig.run_us(2_000);
+    rig.host.from_basic.clear();
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(5_000);
+    assert_eq!(rig.host.received(), angles_reply());
+    assert!(rig.host.from_basic[0].0 >= atom_reply_end_ns(&rig));
+}
+
+#[test]
+fn a_reply_cut_by_noise_leaves_no_frame_and_the_atoms_resend_gets_through() {
+    let reply = angles_reply();
+    // Noise hits the reply from its byte `hit` to its footer: the Basic had begun to pass it on
+    // (its CMD was in), and the frame does not end in FA. The Atom's echo shows it the
+    // collision and it sends the reply again (firmware-atom's schedule; here another station
+    // sends the same bytes once the wire has been quiet).
+    for hit in [5usize, 11, 16] {
+        for cut_through in [true, false] {
+            let mut rig = Rig::new(
+                BasicConfig {
+                    power_on_at_boot: false,
+                    probe_interval_us: 0,
+                    cut_through,
+                    ..BasicConfig::default()
+                },
+                true,
+            );
+            rig.host.send(&frame(GET_ANGLES, &[]));
+            // The scripted Atom keeps clear of traffic it knows is coming: the noise is
+            // scheduled once its reply is on the wire.
+            while rig.atom_sent.is_empty() {
+                rig.step();
+            }
+            let reply_start_ns = rig.atom_sent[0].0;
+            let noise = vec![0x00; reply.len() - hit];
+            rig.wire()
+                .inject(reply_start_ns + hit as u64 * BUS_BYTE_NS, &noise);
+            let resend_ns = reply_start_ns + (reply.len() as u64 + 10) * BUS_BYTE_NS;
+            rig.wire().inject(resend_ns, &reply);
+            rig.run_us(10_000);
+            let context = format!("hit at {hit}, cut-through {cut_through}");
+            let received = rig.host.received();
+            assert_eq!(rig.host_frames().len(), 1, "{context}: {received:02x?}");
+            assert_eq!(
+                pymycobot_reads(&received),
+                std::slice::from_ref(&reply),
+                "{context}"
+            );
+            assert!(received.ends_with(&reply), "{context}");
+            if cut_through {
+                // The garbled reply's start, then filler up to its length: no frame.
+                assert_eq!(
+                    received.len(),
+                    2 * reply.len(),
+                    "{context}: {received:02x?}"
+                );
+                assert_eq!(received[..hit], reply[..hit], "{context}");
+            } else {
+                assert_eq!(received, reply, "{context}");
+            }
+            assert_eq!(rig.atom_got.len(), 1, "{context}: the request went once");
         }
     }
 }
