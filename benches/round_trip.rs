@@ -169,7 +169,7 @@ mod realtime {
     use open_mycobot::host::pty::PseudoTerminal;
     use open_mycobot::host::realtime::{RealtimeDriver, RealtimeRobot};
     use open_mycobot::sim::hops::{HOP_NAMES, Hops};
-    use open_mycobot::sim::{RobotConfig, VirtualRobot};
+    use open_mycobot::sim::{HostLink, RobotConfig, VirtualRobot};
     use protocol_core::command::{Request, cmd};
 
     use super::distribution;
@@ -202,6 +202,11 @@ mod realtime {
         }
         fn run_until(&mut self, t_us: u64) {
             self.robot.run_until(t_us);
+        }
+        fn next_output_us(&self) -> Option<u64> {
+            self.robot
+                .link_next_arrival_ns(HostLink::Basic)
+                .map(|ns| ns.div_ceil(1_000))
         }
     }
 

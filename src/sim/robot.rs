@@ -592,6 +592,17 @@ impl VirtualRobot {
         }
     }
 
+    /// When (virtual ns) the next byte on its way to the host on `link` arrives, if one is on
+    /// the wire: a serial link's; a network client's bytes arrive at once, so never.
+    pub fn link_next_arrival_ns(&self, link: HostLink) -> Option<u64> {
+        let usb = match link {
+            HostLink::Basic => &self.basic.as_ref()?.usb,
+            HostLink::AtomUsb => &self.atom_usb,
+            HostLink::Network(_) => return None,
+        };
+        usb.to_host.next_event_ns()
+    }
+
     /// Takes the next byte that arrived at the host on `link`.
     fn link_receive(&mut self, link: HostLink) -> Option<u8> {
         if let Some(usb) = self.usb_mut(link) {
@@ -1054,6 +1065,29 @@ mod tests {
         let mut frames = Vec::new();
         FrameDecoder::new().feed(&rest, |f| frames.push(f));
         assert_eq!(frames.len(), 1, "the second reply is intact: {rest:02x?}");
+    }
+
+    #[test]
+    fn the_next_byte_to_the_host_is_known_while_it_is_on_the_wire() {
+        let mut robot = VirtualRobot::new(RobotConfig::default());
+        robot.run_for(10_000);
+        assert_eq!(robot.link_next_arrival_ns(HostLink::Basic), None);
+        robot.host_write(&Request::GetBasicVersion.to_frame().to_bytes());
+        let byte_ns = protocol_core::timing::wire_time_ns(1, HOST_BAUD);
+        let mut arrivals = Vec::new();
+        for _ in 0..2_000 {
+            if let Some(t) = robot.link_next_arrival_ns(HostLink::Basic)
+                && arrivals.last() != Some(&t)
+            {
+                arrivals.push(t);
+            }
+            robot.run_for(10);
+        }
+        // The Basic's answer, `FE FE 03 C1 0A FA`: six bytes, one byte time apart.
+        assert_eq!(arrivals.len(), 6, "{arrivals:?}");
+        assert!(arrivals.windows(2).all(|w| w[1] - w[0] == byte_ns));
+        let net = robot.connect().expect("a network client");
+        assert_eq!(robot.link_next_arrival_ns(net), None, "no wire time");
     }
 
     #[test]
