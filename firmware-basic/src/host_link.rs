@@ -101,6 +101,17 @@ pub const MAX_FRAMES_AT_ONCE: usize = MAX_FRAME_BYTES / (3 + MIN_LEN as usize);
 /// The frames one host byte or one quiet gap completed, in order.
 pub(crate) type HostFrames = Vec<Frame, MAX_FRAMES_AT_ONCE>;
 
+/// FNV-1a's starting value.
+const FNV_OFFSET: u32 = 0x811C_9DC5;
+
+/// `bytes` folded into `hash` by FNV-1a: what the bytes of a reply passed on are checked by,
+/// without keeping them.
+fn digest(hash: u32, bytes: &[u8]) -> u32 {
+    bytes
+        .iter()
+        .fold(hash, |h, &b| (h ^ u32::from(b)).wrapping_mul(0x0100_0193))
+}
+
 /// A host link: a listener for what arrives and a bounded queue for what leaves.
 #[derive(Debug)]
 pub(crate) struct HostLink {
@@ -127,8 +138,10 @@ struct Stream {
     /// How many of those are ready for the port (the rest are [`STREAM_FILLER`] standing in
     /// for bytes still to come).
     ready: usize,
-    /// Every byte of it given so far, to check the frame that completes it against.
-    given: Vec<u8, MAX_FRAME_BYTES>,
+    /// How many of its bytes were given so far, and their digest ([`digest`]), to check the
+    /// frame that completes it against.
+    given: usize,
+    given_digest: u32,
     /// Its whole length.
     total: usize,
     /// Still taking bytes (neither completed nor cut).
@@ -266,8 +279,8 @@ impl HostLink {
             ahead,
             len,
             ready: head.len(),
-            // Cannot fail: head.len() < len <= MAX_FRAME_BYTES.
-            given: Vec::from_slice(head).unwrap_or_default(),
+            given: head.len(),
+            given_digest: digest(FNV_OFFSET, head),
             total: len,
             open: true,
         });
@@ -281,7 +294,7 @@ impl HostLink {
             return;
         };
         for &b in bytes {
-            if stream.given.len() + 1 >= stream.total {
+            if stream.given + 1 >= stream.total {
                 break;
             }
             // The reply's bytes still queued: its first `len` of `total` are the last ones.
@@ -290,8 +303,8 @@ impl HostLink {
                 *slot = b;
             }
             stream.ready += 1;
-            // Cannot fail: given.len() < total <= MAX_FRAME_BYTES.
-            let _ = stream.given.push(b);
+            stream.given += 1;
+            stream.given_digest = digest(stream.given_digest, &[b]);
         }
     }
 
@@ -304,12 +317,13 @@ impl HostLink {
             return false;
         };
         let bytes = frame.to_bytes();
-        if bytes.len() != stream.total || !bytes.starts_with(&stream.given) {
+        let given = bytes.get(..stream.given).unwrap_or_default();
+        if bytes.len() != stream.total || digest(FNV_OFFSET, given) != stream.given_digest {
             self.stream_cut();
             return false;
         }
         let done = stream.total - stream.len;
-        for (i, &b) in bytes.iter().enumerate().skip(stream.given.len()) {
+        for (i, &b) in bytes.iter().enumerate().skip(stream.given) {
             // The reply's byte i is at queue index ahead + (i - done) while it is queued.
             if let Some(slot) = i
                 .checked_sub(done)
