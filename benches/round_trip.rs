@@ -8,7 +8,9 @@
 //! the bus, the bus wire both ways, the Atom's turnaround, the Basic's store or cut-through, the
 //! USB wire out. It prints each hop's distribution and the round trips' (median, p90, p99, max)
 //! and their rate, for a client that thinks 0 us (the wire's and the firmware's limit) and one
-//! that thinks a random 0..1 ms (samples every phase of the Atom's refresh cycle).
+//! that thinks a random 0..1 ms (samples every phase of the Atom's refresh cycle), each with
+//! the Basic as shipped and with its reply cut-through and bus hold off (the firmware before
+//! them), and what the servo refresh got meanwhile.
 //!
 //! With `--pty` it measures the real-time front end instead (`src/host/realtime.rs`, what
 //! `cargo run --release` serves): the robot runs on the wall clock behind a pseudo-terminal, and
@@ -22,9 +24,11 @@
 //! `-- --pty <requests>`).
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a bench: a panic is a failed run
 
+use firmware_basic::BasicConfig;
 use open_mycobot::sim::hops::{HOP_NAMES, HopTrace, Hops};
-use open_mycobot::sim::{RobotConfig, VirtualRobot};
+use open_mycobot::sim::{BusByte, RobotConfig, StationId, VirtualRobot};
 use protocol_core::command::{Request, cmd};
+use protocol_core::servo::{Instruction, PacketDecoder};
 use protocol_core::timing::HOST_REPLY_DEADLINE_US;
 use protocol_core::{Frame, FrameDecoder};
 
@@ -117,10 +121,54 @@ fn measure(label: &str, config: RobotConfig, requests: usize, mut think_us: impl
         1e6 / mean_us,
         trips.len(),
     );
+    // What holding the bus for requests costs the servo refresh: state reads per servo.
+    let reads = state_reads(&trace.bus, atom);
+    println!(
+        "  servo state reads per second, servos 1..7: {}; the Basic's bytes on the bus that \
+         were no frame (holding the bus): {}",
+        reads
+            .iter()
+            .map(|n| format!("{:.0}", *n as f64 / elapsed_s))
+            .collect::<Vec<_>>()
+            .join(" "),
+        held_bytes(&trace.bus, basic)
+    );
     println!(
         "  simulated in {:.2} s of wall time\n",
         wall.elapsed().as_secs_f64()
     );
+}
+
+/// READs of each servo 1..7 the Atom put on the bus.
+fn state_reads(bus: &[BusByte], atom: StationId) -> [u64; 7] {
+    let mut counts = [0u64; 7];
+    let bytes: Vec<u8> = bus
+        .iter()
+        .filter(|b| b.from == atom)
+        .map(|b| b.byte)
+        .collect();
+    PacketDecoder::new().feed(&bytes, |p| {
+        if let Ok(Instruction::Read { .. }) = Instruction::parse(&p)
+            && let Some(c) = usize::from(p.id())
+                .checked_sub(1)
+                .and_then(|i| counts.get_mut(i))
+        {
+            *c += 1;
+        }
+    });
+    counts
+}
+
+/// The Basic's bytes on the bus outside its frames.
+fn held_bytes(bus: &[BusByte], basic: StationId) -> usize {
+    let bytes: Vec<u8> = bus
+        .iter()
+        .filter(|b| b.from == basic)
+        .map(|b| b.byte)
+        .collect();
+    let mut in_frames = 0;
+    FrameDecoder::new().feed(&bytes, |f| in_frames += f.encoded_len());
+    bytes.len() - in_frames
 }
 
 fn main() {
@@ -132,30 +180,50 @@ fn main() {
         realtime::measure(requests);
         return;
     }
-    measure(
-        "client thinking 0 us (the wire's and the firmware's limit)",
-        RobotConfig::default(),
-        requests,
-        || 0,
-    );
-    let mut rng = Xorshift(0x2545_f491_4f6c_dd1d);
-    measure(
-        "client thinking 0..1000 us at random (every phase of the Atom's refresh)",
-        RobotConfig::default(),
-        requests,
-        || rng.below(1_000),
-    );
-    let mut rng = Xorshift(0x2545_f491_4f6c_dd1d);
-    measure(
-        "slow main loops (Atom 200 us, Basic 50 us per pass), client thinking 0..1000 us",
-        RobotConfig {
-            atom_loop_us: 200,
-            basic_loop_us: 50,
-            ..RobotConfig::default()
-        },
-        requests,
-        || rng.below(1_000),
-    );
+    let slow = RobotConfig {
+        atom_loop_us: 200,
+        basic_loop_us: 50,
+        ..RobotConfig::default()
+    };
+    for (label, base, random) in [
+        (
+            "client thinking 0 us (the wire's and the firmware's limit)",
+            RobotConfig::default(),
+            false,
+        ),
+        (
+            "client thinking 0..1000 us at random (every phase of the Atom's refresh)",
+            RobotConfig::default(),
+            true,
+        ),
+        (
+            "slow main loops (Atom 200 us, Basic 50 us per pass), client thinking 0..1000 us",
+            slow,
+            true,
+        ),
+    ] {
+        for (firmware, cut_through, bus_hold) in [
+            ("as shipped", true, true),
+            (
+                "replies stored whole, bus not held (before #30)",
+                false,
+                false,
+            ),
+        ] {
+            let config = RobotConfig {
+                basic: BasicConfig {
+                    cut_through,
+                    bus_hold,
+                    ..base.basic
+                },
+                ..base
+            };
+            let mut rng = Xorshift(0x2545_f491_4f6c_dd1d);
+            measure(&format!("{label}, {firmware}"), config, requests, || {
+                if random { rng.below(1_000) } else { 0 }
+            });
+        }
+    }
 }
 
 /// The real-time front end's share of a round trip (`--pty`).

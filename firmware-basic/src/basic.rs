@@ -178,6 +178,14 @@ impl Basic {
                     }
                 }
                 self.forwarder.try_send(now_us, bus, &mut self.bus);
+                // Nothing to send: hold the bus for a request about to be in.
+                let coming = mode == Mode::Framed
+                    && self.forwarder.idle()
+                    && !self.router.has_requests()
+                    && self.wifi_writes.is_empty()
+                    && self.router.request_coming(now_us);
+                self.forwarder
+                    .hold(now_us, bus, &mut self.bus, coming, &self.config);
             }
         }
         self.router.flush(hosts);

@@ -38,6 +38,10 @@ pub struct BasicConfig {
     /// (cut-through: `docs/protocol.md` section 13) rather than once it is complete. On by
     /// default; off, every reply waits for its last byte (what the tests compare against).
     pub cut_through: bool,
+    /// Whether the Basic holds the bus for a request still arriving on a serial link, so it
+    /// goes as soon as it is in rather than at the Atom's next gap between servo transactions
+    /// (`docs/protocol.md` section 13, [`crate::forwarder::HOLD_BYTE`]). On by default.
+    pub bus_hold: bool,
 }
 
 impl Default for BasicConfig {
@@ -53,6 +57,7 @@ impl Default for BasicConfig {
             version_x10: 10,
             dialect: None,
             cut_through: true,
+            bus_hold: true,
         }
     }
 }

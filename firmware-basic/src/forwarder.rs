@@ -218,12 +218,21 @@ struct Late {
     until_us: u64,
 }
 
+/// What the Basic sends to hold the bus for a request still arriving ([`Forwarder::hold`]):
+/// neither a host frame's first byte (`FE`) nor a servo packet's (`FF`), so every station's
+/// decoder skips it; it only keeps the wire from going quiet for the Atom's transaction gap.
+pub const HOLD_BYTE: u8 = 0x00;
+
 /// The bus forwarder.
 #[derive(Debug)]
 pub(crate) struct Forwarder {
     current: Option<InFlight>,
     /// Requests given up on, oldest first, whose replies may still come.
     late: Deque<Late, MAX_LATE>,
+    /// The bus is being held for a request still arriving.
+    holding: bool,
+    /// Another station's byte was heard since the last hold began: the next may begin.
+    heard_other: bool,
 }
 
 impl Forwarder {
@@ -231,7 +240,52 @@ impl Forwarder {
         Self {
             current: None,
             late: Deque::new(),
+            holding: false,
+            heard_other: true,
         }
+    }
+
+    /// Holds the bus for a request still arriving on a host link (`coming`,
+    /// `Router::request_coming`), so that it can go as soon as it is in instead of waiting for
+    /// the Atom's next gap between servo transactions: while the forwarder is idle, a
+    /// [`HOLD_BYTE`] is sent early in each gap, where the Basic may start any transmission
+    /// ([`may_start_after_quiet`]: quiet for [`timing::BUS_QUIET_BEFORE_SEND_US`], before
+    /// [`LATEST_START_IN_GAP_US`]), so the wire is never quiet for the Atom's transaction gap
+    /// and the Atom waits; the request then goes at the first start the rule allows after it
+    /// is in. A wire quiet for longer has no transaction coming (the Atom would have started
+    /// it): no hold, and the request goes at once when it is in. A hold begins only after another station's byte has been heard since the last
+    /// one began (the Atom's reply, or the servo transaction the Atom starts once a hold ends
+    /// without a request), so holds alternate with the Atom's turns on the bus and a client
+    /// sending headers that never become frames cannot starve the servo refresh.
+    pub(crate) fn hold<B: BytePort>(
+        &mut self,
+        now_us: u64,
+        bus: &mut B,
+        listener: &mut Listener,
+        coming: bool,
+        config: &BasicConfig,
+    ) {
+        if !(config.bus_hold && coming && self.idle()) {
+            self.holding = false;
+            return;
+        }
+        if !self.holding {
+            if !self.heard_other {
+                return;
+            }
+            self.holding = true;
+            self.heard_other = false;
+        }
+        // Only early in the Atom's gap: a wire quiet for longer has no transaction coming (the
+        // Atom would have started it), and the request goes at once when it is in.
+        let quiet_us = listener.quiet_us(now_us);
+        let early_in_gap =
+            (timing::BUS_QUIET_BEFORE_SEND_US..LATEST_START_IN_GAP_US).contains(&quiet_us);
+        if !early_in_gap || !bus.tx_idle() || listener.echo_pending() {
+            return;
+        }
+        bus.write(&[HOLD_BYTE]);
+        listener.on_transmit(now_us, &[HOLD_BYTE]);
     }
 
     /// True when no request is in flight: the next may start.
@@ -304,7 +358,10 @@ impl Forwarder {
     ) {
         match heard {
             Heard::Echo(echo) => self.on_echo(now_us, echo, line.echoes, config, on_event),
-            Heard::Byte(byte) => self.note_reply_byte(byte, position, line.silence_before),
+            Heard::Byte(byte) => {
+                self.heard_other = true;
+                self.note_reply_byte(byte, position, line.silence_before);
+            }
             Heard::Frame(frame) => self.on_frame(now_us, frame, on_event),
             Heard::Packet(_) => {}
         }
@@ -975,6 +1032,76 @@ mod tests {
             1,
             "a resend of the same question: its answer"
         );
+    }
+
+    /// An idle forwarder whose listener last heard another station's byte at `t_us`.
+    fn idle_after_a_byte_at(t_us: u64) -> (Forwarder, Listener, BasicConfig) {
+        let mut forwarder = Forwarder::new();
+        let mut listener = bus_listener(EchoMode::Absent);
+        let config = BasicConfig::default();
+        forwarder.on_bus_byte(t_us, 0xFF, &mut listener, &config, |_| {});
+        (forwarder, listener, config)
+    }
+
+    #[test]
+    fn the_bus_is_held_only_early_in_the_atoms_gap() {
+        for quiet_us in 0..200 {
+            let (mut forwarder, mut listener, config) = idle_after_a_byte_at(1_000);
+            let mut port = Port::default();
+            forwarder.hold(1_000 + quiet_us, &mut port, &mut listener, true, &config);
+            let early =
+                (timing::BUS_QUIET_BEFORE_SEND_US..LATEST_START_IN_GAP_US).contains(&quiet_us);
+            let expected: &[u8] = if early { &[HOLD_BYTE] } else { &[] };
+            assert_eq!(port.0, expected, "quiet {quiet_us} us");
+        }
+    }
+
+    #[test]
+    fn the_bus_is_held_only_for_a_request_coming_while_idle_and_if_configured() {
+        let early = 1_000 + timing::BUS_QUIET_BEFORE_SEND_US;
+        let (mut forwarder, mut listener, config) = idle_after_a_byte_at(1_000);
+        let mut port = Port::default();
+        forwarder.hold(early, &mut port, &mut listener, false, &config);
+        let off = BasicConfig {
+            bus_hold: false,
+            ..config
+        };
+        forwarder.hold(early, &mut port, &mut listener, true, &off);
+        assert!(port.0.is_empty(), "nothing coming, or holding off");
+        let mut w = Waiting::new(cmd::GET_ANGLES, true);
+        let quiet_since = w.now_us;
+        w.forwarder.hold(
+            quiet_since + 65,
+            &mut port,
+            &mut w.listener,
+            true,
+            &w.config,
+        );
+        assert!(port.0.is_empty(), "a request in flight");
+    }
+
+    #[test]
+    fn holds_alternate_with_another_stations_turn() {
+        let (mut forwarder, mut listener, config) = idle_after_a_byte_at(1_000);
+        let mut port = Port::default();
+        // A poll at `t`: time passes (echo verdicts), then the hold.
+        let poll = |t: u64, coming: bool, f: &mut Forwarder, l: &mut Listener, p: &mut Port| {
+            f.on_time(t, &*p, l, &config, |_| {});
+            f.hold(t, p, l, coming, &config);
+        };
+        // A hold: a byte early in each gap while the request comes.
+        poll(1_065, true, &mut forwarder, &mut listener, &mut port);
+        poll(1_140, true, &mut forwarder, &mut listener, &mut port);
+        assert_eq!(port.0, [HOLD_BYTE; 2]);
+        // It was no request after all (the frame failed): the hold ends. The next one waits
+        // for another station's turn on the bus.
+        poll(1_215, false, &mut forwarder, &mut listener, &mut port);
+        poll(1_290, true, &mut forwarder, &mut listener, &mut port);
+        poll(1_365, true, &mut forwarder, &mut listener, &mut port);
+        assert_eq!(port.0.len(), 2, "no hold before the Atom had its turn");
+        forwarder.on_bus_byte(1_400, 0xFF, &mut listener, &config, |_| {});
+        poll(1_465, true, &mut forwarder, &mut listener, &mut port);
+        assert_eq!(port.0.len(), 3, "after it");
     }
 
     #[test]

@@ -3,8 +3,9 @@
 //! gap for truncated frames) and queues bytes for the client without ever blocking the loop.
 
 use heapless::{Deque, Vec};
+use protocol_core::command::is_basic_local;
 use protocol_core::dialect::Dialect;
-use protocol_core::frame::{MAX_FRAME_BYTES, MIN_LEN};
+use protocol_core::frame::{HEADER, MAX_FRAME_BYTES, MAX_LEN, MIN_FRAME_BYTES, MIN_LEN};
 use protocol_core::listener::{Heard, Listener, ListenerConfig};
 use protocol_core::{Frame, timing};
 
@@ -41,6 +42,12 @@ pub const NETWORK_TEXT_GAP_US: u64 = 5_000;
 /// How long pymycobot's socket client waits for a reply before it sends again, in microseconds
 /// (`MyCobot280Socket`: 0.3 s per try; the serial client waits 0.5 s).
 pub const NETWORK_REPLY_DEADLINE_US: u64 = 300_000;
+
+/// Most bytes a request may still have to come, at the line's speed, for the bus to be held
+/// for it ([`HostLink::request_coming`]): 8, 0.69 ms at 115200. A `get_angles` (5 bytes) is
+/// held for from its first byte; a longer request from its last 8. It bounds how long the
+/// Atom's servo refresh waits for one request.
+pub const HOLD_MAX_REMAINING_BYTES: usize = 8;
 
 /// What a host link is, which sets its timing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -176,6 +183,33 @@ impl HostLink {
     /// Microseconds since the last host byte arrived.
     pub(crate) fn quiet_for_us(&self, now_us: u64) -> u64 {
         self.rx.quiet_us(now_us)
+    }
+
+    /// True if a request for the Atom seems to be arriving on this link at `now_us`, with at
+    /// most [`HOLD_MAX_REMAINING_BYTES`] still to come: a serial link in pymycobot's dialect
+    /// whose frame in progress has a header that can be a frame's (`FE`, `FE FE`, a LEN from
+    /// `MIN_LEN` to `MAX_LEN`, a CMD that is not one of the Basic's own), whose last byte came
+    /// within two byte times (the client is still sending it, back to back), and whose LEN (a
+    /// shortest frame while it is not in yet) leaves few bytes to come. The Basic holds the bus
+    /// for it ([`crate::forwarder::Forwarder::hold`]).
+    pub(crate) fn request_coming(&self, now_us: u64) -> bool {
+        if self.kind != LinkKind::Serial || self.dialect != Dialect::Pymycobot {
+            return false;
+        }
+        let (_, partial) = self.rx.frame_partial();
+        let length = match partial {
+            [HEADER] | [HEADER, HEADER] => MIN_FRAME_BYTES,
+            [HEADER, HEADER, len, rest @ ..] if (MIN_LEN..=MAX_LEN).contains(len) => {
+                if rest.first().is_some_and(|&cmd| is_basic_local(cmd)) {
+                    return false;
+                }
+                3 + usize::from(*len)
+            }
+            _ => return false,
+        };
+        let byte_us = timing::wire_time_us(1, timing::HOST_BAUD);
+        self.rx.quiet_us(now_us) <= 2 * byte_us
+            && length.saturating_sub(partial.len()) <= HOLD_MAX_REMAINING_BYTES
     }
 
     /// Drops a partial frame once the client has been quiet for the link's gap (it was cut
@@ -549,6 +583,53 @@ mod tests {
             expected,
             "the oldest went, the newest stayed"
         );
+    }
+
+    #[test]
+    fn a_request_is_coming_while_a_plausible_frame_arrives_with_few_bytes_to_go() {
+        let byte = timing::wire_time_us(1, timing::HOST_BAUD);
+        // Each prefix of a frame, heard at line speed: is a request coming right after it?
+        let coming_after = |bytes: &[u8], kind: LinkKind| {
+            let mut link = HostLink::new(kind);
+            hear_all(&mut link, 0, bytes);
+            let last = byte * (bytes.len() as u64 - 1);
+            link.request_coming(last + byte)
+        };
+        for n in 1..GET_ANGLES.len() {
+            assert!(
+                coming_after(&GET_ANGLES[..n], LinkKind::Serial),
+                "{n} bytes in"
+            );
+            assert!(
+                !coming_after(&GET_ANGLES[..n], LinkKind::Network),
+                "a network link"
+            );
+        }
+        assert!(
+            !coming_after(&GET_ANGLES, LinkKind::Serial),
+            "in: no longer coming"
+        );
+        // The Basic's own command (0xC1), and a LEN no frame has.
+        assert!(!coming_after(&[0xFE, 0xFE, 0x02, 0xC1], LinkKind::Serial));
+        assert!(!coming_after(&[0xFE, 0xFE, 0x41], LinkKind::Serial));
+        // A long frame: only its last 8 bytes.
+        let mut send_angles = std::vec![0xFE, 0xFE, 0x0F, 0x22];
+        send_angles.extend_from_slice(&[0; 13]);
+        assert!(!coming_after(&send_angles[..9], LinkKind::Serial));
+        assert!(coming_after(&send_angles[..10], LinkKind::Serial));
+        // A client that stopped sending mid-frame.
+        let mut link = HostLink::new(LinkKind::Serial);
+        hear_all(&mut link, 0, &GET_ANGLES[..2]);
+        assert!(link.request_coming(byte * 2));
+        assert!(
+            !link.request_coming(byte * 4),
+            "quiet for over two byte times"
+        );
+        // Another dialect reads other lengths.
+        let mut link = HostLink::new(LinkKind::Serial);
+        assert!(link.adopt(Dialect::Seed));
+        hear_all(&mut link, 0, &GET_ANGLES[..2]);
+        assert!(!link.request_coming(byte * 2));
     }
 
     /// `get_angles`' reply as the Atom sends it.

@@ -32,7 +32,10 @@
 //!   collisions the echo proves retried; a client's request is otherwise never sent twice.
 //!   Only the reply with the request's CMD comes back, a request the Atom does not answer is
 //!   given up after [`BasicConfig::reply_timeout_us`] (below pymycobot's 0.5 s resend), and
-//!   its late reply is dropped, never taken for another request's. A serial client's reply
+//!   its late reply is dropped, never taken for another request's. While a request is still
+//!   arriving on a serial link, the Basic holds the bus with a `00` byte early in each of the
+//!   Atom's gaps ([`forwarder::HOLD_BYTE`]), so the request goes as soon as it is in. A serial
+//!   client's reply
 //!   is passed on as it arrives (cut-through, all but its last byte before it is whole); one
 //!   cut short leaves the client a frame header whose frame ends in filler, no frame.
 //! * [`transparent`]: after `0xC2 01` raw bytes go both ways (the Basic's echo removed)
@@ -94,8 +97,9 @@
 //! link's transmitter was last idle), so a write never waits on a 128-byte UART FIFO. Timing
 //! comes only from `now_us`.
 //!
-//! Latency (bench `latency`, virtual time): the Basic adds one poll period to each direction
-//! on an idle wire, beyond the frame's own wire time. Several clients (bench `router`): no
+//! Latency (bench `latency`, virtual time): the Basic adds one poll period host -> bus on an
+//! idle wire, beyond the frame's own wire time; bus -> host its reply is on its way before it
+//! has ended on the bus (cut-through). Several clients (bench `router`): no
 //! reply crossed or lost, the bus shared round robin.
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]

@@ -315,6 +315,14 @@ impl Router {
         }
     }
 
+    /// True if a request for the Atom seems to be arriving on some link, soon to be in
+    /// ([`HostLink::request_coming`]); a link capturing a 0xB0 text is not sending a frame.
+    pub(crate) fn request_coming(&self, now_us: u64) -> bool {
+        self.slots
+            .iter()
+            .any(|s| s.open && s.capture.is_none() && s.link.request_coming(now_us))
+    }
+
     /// True if any link has a request waiting.
     pub(crate) fn has_requests(&self) -> bool {
         self.slots.iter().any(|s| s.open && !s.waiting.is_empty())

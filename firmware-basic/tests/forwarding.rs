@@ -4,9 +4,11 @@
 mod common;
 
 use common::{BUS_BYTE_NS, Rig, frame, pymycobot_reads};
+use firmware_basic::forwarder::HOLD_BYTE;
 use firmware_basic::host_link::STREAM_FILLER;
 use firmware_basic::{AtomLink, BasicConfig, BasicError, EchoMode};
 use protocol_core::Frame;
+use protocol_core::timing::BUS_QUIET_BEFORE_SEND_US;
 
 const GET_ANGLES: u8 = 0x20;
 const IS_POWERED_ON: u8 = 0x12;
@@ -770,4 +772,92 @@ fn a_reply_cut_by_noise_leaves_no_frame_and_the_atoms_resend_gets_through() {
             assert_eq!(rig.atom_got.len(), 1, "{context}: the request went once");
         }
     }
+}
+
+/// A rig whose scripted Atom polls a servo from 1 ms on, with the bus hold on or off.
+fn polling_rig(bus_hold: bool) -> Rig {
+    let mut rig = Rig::new(
+        BasicConfig {
+            power_on_at_boot: false,
+            probe_interval_us: 0,
+            bus_hold,
+            ..BasicConfig::default()
+        },
+        true,
+    );
+    rig.step_ns = 2_000;
+    rig.run_us(1_000);
+    let now = rig.now_ns;
+    rig.wire().poll_servos(now, now + 1_000_000_000);
+    rig
+}
+
+/// How long after it was in (its last byte from the host) the request went onto the bus, us,
+/// when the host starts sending it `phase_ns` after the Atom started polling.
+fn request_wait_us(bus_hold: bool, phase_ns: u64) -> u64 {
+    let mut rig = polling_rig(bus_hold);
+    rig.run_us(phase_ns / 1_000);
+    let in_ns = rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(3_000);
+    assert_eq!(
+        rig.host.received(),
+        angles_reply(),
+        "hold {bus_hold}, phase {phase_ns}"
+    );
+    assert_eq!(rig.atom_got.len(), 1);
+    assert_eq!(rig.wire().collisions(), 0);
+    let sent = rig.wire().basic_sent.clone();
+    let frame_start = sent
+        .windows(2)
+        .find(|w| w[0].1 == 0xFE && w[1].1 == 0xFE)
+        .map(|w| w[0].0)
+        .unwrap();
+    let held = sent
+        .iter()
+        .filter(|&&(t, b)| t < frame_start && b == HOLD_BYTE)
+        .count();
+    assert!(bus_hold || held == 0);
+    (frame_start - in_ns) / 1_000
+}
+
+#[test]
+fn while_the_atom_polls_a_request_goes_soon_after_it_is_in_if_the_bus_was_held_for_it() {
+    let phases: Vec<u64> = (0..40).map(|k| k * 10_997).collect();
+    let held: Vec<u64> = phases.iter().map(|&p| request_wait_us(true, p)).collect();
+    let not_held: Vec<u64> = phases.iter().map(|&p| request_wait_us(false, p)).collect();
+    for ((phase, h), n) in phases.iter().zip(&held).zip(&not_held) {
+        // After its last hold byte the request waits for the quiet every start needs.
+        assert!(
+            *h <= n + BUS_QUIET_BEFORE_SEND_US,
+            "phase {phase} ns: {h} us held, {n} us not"
+        );
+    }
+    let mean = |w: &[u64]| w.iter().sum::<u64>() / w.len() as u64;
+    assert!(
+        mean(&held) * 3 < mean(&not_held),
+        "held {held:?}, not held {not_held:?}"
+    );
+}
+
+#[test]
+fn a_client_whose_frames_never_end_cannot_starve_the_servo_refresh() {
+    // Plausible headers back to back, each with a footer that is not FA: every one looks like a
+    // request coming until its last byte.
+    let junk: Vec<u8> = [0xFE, 0xFE, 0x03, GET_ANGLES, 0x01, 0x00].repeat(200);
+    let reads = |bus_hold: bool| {
+        let mut rig = polling_rig(bus_hold);
+        let from = rig.wire().servo_reads.len();
+        rig.host.send(&junk);
+        rig.run_us(100_000);
+        assert!(rig.atom_got.is_empty());
+        assert!(rig.host.received().is_empty());
+        rig.wire().servo_reads.len() - from
+    };
+    let (held, free) = (reads(true), reads(false));
+    // At least one servo transaction after each hold: here about one per junk header.
+    assert!(
+        held * 2 >= free,
+        "{held} servo reads with the hold, {free} without"
+    );
+    assert!(held >= 100_000 / 1_300, "{held}");
 }
