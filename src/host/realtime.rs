@@ -327,7 +327,8 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
         let mut input = [0u8; 4096];
         let mut output = Vec::with_capacity(256);
         // Sleeps end when asked, not up to the kernel's default 50 us later: a reply byte is
-        // passed on when it arrives.
+        // passed on when it arrives (Linux; elsewhere the kernel's own slack applies).
+        #[cfg(any(target_os = "linux", target_os = "android"))]
         let _ = nix::sys::prctl::set_timerslack(TIMER_SLACK_NS);
         while !stop.load(Ordering::Relaxed) {
             let active =
