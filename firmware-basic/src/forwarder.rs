@@ -218,7 +218,7 @@ struct Late {
     until_us: u64,
 }
 
-/// What the Basic sends to hold the bus for a request still arriving ([`Forwarder::hold`]):
+/// What the Basic sends to hold the bus for a request still arriving (`Forwarder::hold`):
 /// neither a host frame's first byte (`FE`) nor a servo packet's (`FF`), so every station's
 /// decoder skips it; it only keeps the wire from going quiet for the Atom's transaction gap.
 pub const HOLD_BYTE: u8 = 0x00;

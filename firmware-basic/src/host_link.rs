@@ -15,7 +15,7 @@ use protocol_core::{Frame, timing};
 pub const HOST_TX_CAPACITY: usize = 512;
 /// Most bytes handed to the host port in one write: well under the ESP32 UART's 128-byte FIFO,
 /// so a write into an idle transmitter never waits. It also bounds what a reply passed on as
-/// it arrives ([`HostLink::stream_open`]) hands a busy port since it was last idle, so those
+/// it arrives (`HostLink::stream_open`) hands a busy port since it was last idle, so those
 /// writes never wait either.
 pub const HOST_WRITE_CHUNK: usize = 64;
 
@@ -44,7 +44,7 @@ pub const NETWORK_TEXT_GAP_US: u64 = 5_000;
 pub const NETWORK_REPLY_DEADLINE_US: u64 = 300_000;
 
 /// Most bytes a request may still have to come, at the line's speed, for the bus to be held
-/// for it ([`HostLink::request_coming`]): 8, 0.69 ms at 115200. A `get_angles` (5 bytes) is
+/// for it (`HostLink::request_coming`): 8, 0.69 ms at 115200. A `get_angles` (5 bytes) is
 /// held for from its first byte; a longer request from its last 8. It bounds how long the
 /// Atom's servo refresh waits for one request.
 pub const HOLD_MAX_REMAINING_BYTES: usize = 8;
