@@ -32,6 +32,16 @@
 //!
 //! The Basic's own requests (0x12, and 0x10 to an Atom that said it is off) are asked again
 //! at once when their reply comes garbled or their echo is missing: asking twice does no harm.
+//!
+//! **Cut-through.** A serial client's reply is reported as it arrives (`Event::ReplyHead`,
+//! `Event::ReplyMore`), from the moment its first four bytes show it is the reply, all but its
+//! last byte ([`streamable_prefix`]); the frame completes it (`Event::Reply`), a candidate
+//! dropped cuts it (`Event::ReplyCut`). Which reply counts is decided exactly as before, on
+//! the whole frame.
+//!
+//! **Holding the bus.** While a request is still arriving on a host link and nothing is in
+//! flight, `Forwarder::hold` keeps the Atom's next servo transaction back with a
+//! [`HOLD_BYTE`] early in each of its gaps, so the request goes as soon as it is in.
 
 use heapless::{Deque, Vec};
 use protocol_core::frame::{HEADER, MAX_FRAME_BYTES, MAX_REPLY_DATA, MIN_LEN};
@@ -253,10 +263,11 @@ impl Forwarder {
     /// [`LATEST_START_IN_GAP_US`]), so the wire is never quiet for the Atom's transaction gap
     /// and the Atom waits; the request then goes at the first start the rule allows after it
     /// is in. A wire quiet for longer has no transaction coming (the Atom would have started
-    /// it): no hold, and the request goes at once when it is in. A hold begins only after another station's byte has been heard since the last
-    /// one began (the Atom's reply, or the servo transaction the Atom starts once a hold ends
-    /// without a request), so holds alternate with the Atom's turns on the bus and a client
-    /// sending headers that never become frames cannot starve the servo refresh.
+    /// it): no hold, and the request goes at once when it is in. A hold begins only after
+    /// another station's byte has been heard since the last one began (the Atom's reply, or
+    /// the servo transaction the Atom starts once a hold ends without a request), so holds
+    /// alternate with the Atom's turns on the bus and a client sending headers that never
+    /// become frames cannot starve the servo refresh.
     pub(crate) fn hold<B: BytePort>(
         &mut self,
         now_us: u64,
