@@ -1,9 +1,11 @@
 //! Forwarding latency of the transponder, in virtual time: how long after the last byte of a
-//! frame arrives the first byte of the forwarded frame leaves, host -> bus (115200 in, 1 Mbaud
-//! out) and bus -> host (1 Mbaud in, 115200 out). That is the latency the Basic adds beyond
-//! the wire time of the frame itself; the target is under 50 us each way. The Basic is polled
-//! every `poll` microseconds (a board's loop is far faster; the virtual robot polls every
-//! 10 us). Also reports the host CPU time of one poll.
+//! request arrives the first byte of the forwarded frame leaves, host -> bus (115200 in, 1 Mbaud
+//! out), and when the reply's first byte leaves to the host against the reply's last byte on
+//! the bus, bus -> host (1 Mbaud in, 115200 out; negative: passed on before it ended, the
+//! cut-through). That is the latency the Basic adds beyond the wire time of the frame itself;
+//! the target is under 50 us each way. The Basic is polled every `poll` microseconds (a board's
+//! loop is far faster; the virtual robot polls every 10 us). Also reports the host CPU time of
+//! one poll.
 //!
 //! Run: `cargo bench -p firmware-basic --bench latency`.
 #![allow(clippy::unwrap_used, clippy::indexing_slicing, missing_docs)]
@@ -25,7 +27,7 @@ fn measure(
     poll_ns: u64,
     rounds: usize,
     servo_traffic: bool,
-) -> (Vec<u64>, Vec<u64>) {
+) -> (Vec<i64>, Vec<i64>) {
     let config = BasicConfig {
         echo: EchoMode::Auto,
         power_on_at_boot: false,
@@ -57,22 +59,27 @@ fn measure(
         let host_before = rig.host.from_basic.len();
         let arrived = rig.host.send(request);
         assert!(rig.run_until_host_has(host_before + 1, 20_000), "no reply");
-        let first_out = rig.wire().basic_sent[sent_before].0;
-        to_bus.push(first_out - arrived);
+        // The request's first byte (bytes before it held the bus for it).
+        let sent = &rig.wire().basic_sent[sent_before..];
+        let first_out = sent
+            .windows(2)
+            .find(|w| w[0].1 == 0xFE && w[1].1 == 0xFE)
+            .map_or(sent[0].0, |w| w[0].0);
+        to_bus.push(first_out as i64 - arrived as i64);
         let (reply_start, reply) = rig.atom_sent.last().unwrap().clone();
         let reply_end = reply_start + reply.len() as u64 * common::BUS_BYTE_NS;
         // Let the whole reply out before the next request.
         rig.run_us(if servo_traffic { 6_000 } else { 3_000 });
-        to_host.push(rig.host.from_basic[host_before].0 - reply_end);
+        to_host.push(rig.host.from_basic[host_before].0 as i64 - reply_end as i64);
     }
     (to_bus, to_host)
 }
 
-fn summary(ns: &mut [u64]) -> String {
+fn summary(ns: &mut [i64]) -> String {
     ns.sort_unstable();
     let pct = |p: usize| ns[(ns.len() - 1) * p / 100] as f64 / 1_000.0;
     format!(
-        "median {:5.1} us  p99 {:5.1} us  max {:5.1} us",
+        "median {:6.1} us  p99 {:6.1} us  max {:6.1} us",
         pct(50),
         pct(99),
         pct(100)

@@ -15,7 +15,7 @@ use crate::forwarder::{self, Event, Forwarder};
 use crate::host_link::{HOST_READ_BUDGET, HostFrames, LinkKind};
 use crate::io::BasicIo;
 use crate::local;
-use crate::request::{Client, LinkId, MAX_HOST_LINKS};
+use crate::request::{Client, LinkId, MAX_HOST_LINKS, Origin};
 use crate::router::{HostPorts, LinksFull, Router};
 use crate::status::{BasicError, BasicStatus, TransponderMode};
 use crate::supervisor::Supervisor;
@@ -178,6 +178,14 @@ impl Basic {
                     }
                 }
                 self.forwarder.try_send(now_us, bus, &mut self.bus);
+                // Nothing to send: hold the bus for a request about to be in.
+                let coming = mode == Mode::Framed
+                    && self.forwarder.idle()
+                    && !self.router.has_requests()
+                    && self.wifi_writes.is_empty()
+                    && self.router.request_coming(now_us);
+                self.forwarder
+                    .hold(now_us, bus, &mut self.bus, coming, &self.config);
             }
         }
         self.router.flush(hosts);
@@ -454,6 +462,28 @@ fn deliver(now_us: u64, event: Event, supervisor: &mut Supervisor, router: &mut 
         Event::Reply { request, reply } => (request.origin, request.answer.reply(&reply)),
         Event::Timeout(request) | Event::GaveUp(request) => {
             (request.origin, request.answer.unanswered())
+        }
+        // A reply passed on as it arrives (only ever a client's, as it is).
+        Event::ReplyHead {
+            origin: Origin::Host(client),
+            head,
+            len,
+        } => {
+            router.stream_open(client, &head, len);
+            return;
+        }
+        Event::ReplyMore {
+            origin: Origin::Host(client),
+            bytes,
+        } => {
+            router.stream_more(client, &bytes);
+            return;
+        }
+        Event::ReplyCut {
+            origin: Origin::Host(client),
+        } => {
+            router.stream_cut(client);
+            return;
         }
         _ => return,
     };

@@ -34,6 +34,14 @@ pub struct BasicConfig {
     /// The dialect to speak from boot (the virtual robot's `--dialect`), kept in the store
     /// too; `None`: the stored one, or pymycobot's.
     pub dialect: Option<protocol_core::dialect::Dialect>,
+    /// Whether a reply for a serial client is passed on as it arrives on the bus
+    /// (cut-through: `docs/protocol.md` section 13) rather than once it is complete. On by
+    /// default; off, every reply waits for its last byte (what the tests compare against).
+    pub cut_through: bool,
+    /// Whether the Basic holds the bus for a request still arriving on a serial link, so it
+    /// goes as soon as it is in rather than at the Atom's next gap between servo transactions
+    /// (`docs/protocol.md` section 13, [`crate::forwarder::HOLD_BYTE`]). On by default.
+    pub bus_hold: bool,
 }
 
 impl Default for BasicConfig {
@@ -48,6 +56,8 @@ impl Default for BasicConfig {
             power_on_at_boot: true,
             version_x10: 10,
             dialect: None,
+            cut_through: true,
+            bus_hold: true,
         }
     }
 }

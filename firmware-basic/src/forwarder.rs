@@ -32,9 +32,19 @@
 //!
 //! The Basic's own requests (0x12, and 0x10 to an Atom that said it is off) are asked again
 //! at once when their reply comes garbled or their echo is missing: asking twice does no harm.
+//!
+//! **Cut-through.** A serial client's reply is reported as it arrives (`Event::ReplyHead`,
+//! `Event::ReplyMore`), from the moment its first four bytes show it is the reply, all but its
+//! last byte ([`streamable_prefix`]); the frame completes it (`Event::Reply`), a candidate
+//! dropped cuts it (`Event::ReplyCut`). Which reply counts is decided exactly as before, on
+//! the whole frame.
+//!
+//! **Holding the bus.** While a request is still arriving on a host link and nothing is in
+//! flight, `Forwarder::hold` keeps the Atom's next servo transaction back with a
+//! [`HOLD_BYTE`] early in each of its gaps, so the request goes as soon as it is in.
 
 use heapless::{Deque, Vec};
-use protocol_core::frame::{HEADER, MAX_FRAME_BYTES};
+use protocol_core::frame::{HEADER, MAX_FRAME_BYTES, MAX_REPLY_DATA, MIN_LEN};
 use protocol_core::listener::{Echo, Heard, Listener, ListenerConfig};
 use protocol_core::{BytePort, Frame, timing};
 
@@ -115,6 +125,23 @@ pub(crate) enum Event {
     Late { request: Request, reply: Frame },
     /// A frame from the bus answered nothing outstanding and was dropped.
     Unsolicited,
+    /// The reply to a request from `origin` has begun on the bus and is passed on as it
+    /// arrives (cut-through, [`Request::cut_through`]): `head`, its first bytes, of a frame
+    /// `len` bytes long. Its next bytes follow ([`Event::ReplyMore`]); the frame itself ends
+    /// it ([`Event::Reply`], whose frame completes what was passed on), or [`Event::ReplyCut`].
+    ReplyHead {
+        origin: Origin,
+        head: Vec<u8, MAX_FRAME_BYTES>,
+        len: usize,
+    },
+    /// The next bytes of the reply being passed on.
+    ReplyMore {
+        origin: Origin,
+        bytes: Vec<u8, MAX_FRAME_BYTES>,
+    },
+    /// The reply being passed on did not complete (cut short by silence, not a frame after
+    /// all): the client must not find a frame in what it was given.
+    ReplyCut { origin: Origin },
 }
 
 impl Event {
@@ -126,6 +153,9 @@ impl Event {
             | Self::Timeout(request)
             | Self::GaveUp(request)
             | Self::Expired(request) => Some(request.origin),
+            Self::ReplyHead { origin, .. }
+            | Self::ReplyMore { origin, .. }
+            | Self::ReplyCut { origin } => Some(*origin),
             Self::Collision | Self::Unsolicited => None,
         }
     }
@@ -143,11 +173,14 @@ enum Stage {
     /// transmission (the first byte heard, or one after a silence; servo packets begin with
     /// `FF`), `FE FE` anywhere, or a valid frame for another command. `heard_any` and
     /// `last_fe` track what came before.
+    /// `burst_fe` is the stream position of the last `FE` that began a transmission: only a
+    /// reply starting there is passed on as it arrives.
     AwaitReply {
         deadline_us: u64,
         heard_any: bool,
         last_fe: bool,
         reply_started: bool,
+        burst_fe: Option<u64>,
     },
 }
 
@@ -157,6 +190,34 @@ struct InFlight {
     wire: Vec<u8, MAX_FRAME_BYTES>,
     attempts: u8,
     stage: Stage,
+    /// The reply being passed on as it arrives, if it is.
+    stream: Option<Streamed>,
+}
+
+/// A reply being passed on as it arrives: the frame candidate the listener is hearing.
+#[derive(Debug)]
+struct Streamed {
+    /// The stream position of its first byte ([`Listener::frame_partial`]).
+    start: u64,
+    /// How many of its bytes have been passed on.
+    given: usize,
+    /// Its whole length.
+    len: usize,
+}
+
+/// Longest reply passed on as it arrives: pymycobot's longest (it reads no LEN above 30, and
+/// would take a larger LEN byte for something else).
+pub const MAX_STREAMED_LEN: u8 = MAX_REPLY_DATA as u8 + 2;
+
+/// How many leading bytes of `candidate`, a frame `len` bytes long, may be given to the client
+/// before the frame is complete: never its last byte (the `FA` that makes it a frame), and
+/// nothing from the second `FE` of an `FE FE` inside it on. So a reply cut short leaves the
+/// client a frame header whose frame never ends, with no other frame header inside it.
+pub fn streamable_prefix(candidate: &[u8], len: usize) -> usize {
+    let end = candidate.len().min(len.saturating_sub(1));
+    (3..end)
+        .find(|&i| candidate.get(i) == Some(&HEADER) && candidate.get(i - 1) == Some(&HEADER))
+        .unwrap_or(end)
 }
 
 /// A request given up on whose reply may still come.
@@ -167,12 +228,21 @@ struct Late {
     until_us: u64,
 }
 
+/// What the Basic sends to hold the bus for a request still arriving (`Forwarder::hold`):
+/// neither a host frame's first byte (`FE`) nor a servo packet's (`FF`), so every station's
+/// decoder skips it; it only keeps the wire from going quiet for the Atom's transaction gap.
+pub const HOLD_BYTE: u8 = 0x00;
+
 /// The bus forwarder.
 #[derive(Debug)]
 pub(crate) struct Forwarder {
     current: Option<InFlight>,
     /// Requests given up on, oldest first, whose replies may still come.
     late: Deque<Late, MAX_LATE>,
+    /// The bus is being held for a request still arriving.
+    holding: bool,
+    /// Another station's byte was heard since the last hold began: the next may begin.
+    heard_other: bool,
 }
 
 impl Forwarder {
@@ -180,7 +250,53 @@ impl Forwarder {
         Self {
             current: None,
             late: Deque::new(),
+            holding: false,
+            heard_other: true,
         }
+    }
+
+    /// Holds the bus for a request still arriving on a host link (`coming`,
+    /// `Router::request_coming`), so that it can go as soon as it is in instead of waiting for
+    /// the Atom's next gap between servo transactions: while the forwarder is idle, a
+    /// [`HOLD_BYTE`] is sent early in each gap, where the Basic may start any transmission
+    /// ([`may_start_after_quiet`]: quiet for [`timing::BUS_QUIET_BEFORE_SEND_US`], before
+    /// [`LATEST_START_IN_GAP_US`]), so the wire is never quiet for the Atom's transaction gap
+    /// and the Atom waits; the request then goes at the first start the rule allows after it
+    /// is in. A wire quiet for longer has no transaction coming (the Atom would have started
+    /// it): no hold, and the request goes at once when it is in. A hold begins only after
+    /// another station's byte has been heard since the last one began (the Atom's reply, or
+    /// the servo transaction the Atom starts once a hold ends without a request), so holds
+    /// alternate with the Atom's turns on the bus and a client sending headers that never
+    /// become frames cannot starve the servo refresh.
+    pub(crate) fn hold<B: BytePort>(
+        &mut self,
+        now_us: u64,
+        bus: &mut B,
+        listener: &mut Listener,
+        coming: bool,
+        config: &BasicConfig,
+    ) {
+        if !(config.bus_hold && coming && self.idle()) {
+            self.holding = false;
+            return;
+        }
+        if !self.holding {
+            if !self.heard_other {
+                return;
+            }
+            self.holding = true;
+            self.heard_other = false;
+        }
+        // Only early in the Atom's gap: a wire quiet for longer has no transaction coming (the
+        // Atom would have started it), and the request goes at once when it is in.
+        let quiet_us = listener.quiet_us(now_us);
+        let early_in_gap =
+            (timing::BUS_QUIET_BEFORE_SEND_US..LATEST_START_IN_GAP_US).contains(&quiet_us);
+        if !early_in_gap || !bus.tx_idle() || listener.echo_pending() {
+            return;
+        }
+        bus.write(&[HOLD_BYTE]);
+        listener.on_transmit(now_us, &[HOLD_BYTE]);
     }
 
     /// True when no request is in flight: the next may start.
@@ -205,6 +321,7 @@ impl Forwarder {
             wire,
             attempts: 0,
             stage: Stage::WaitQuiet { not_before_us: 0 },
+            stream: None,
         });
     }
 
@@ -218,9 +335,16 @@ impl Forwarder {
         mut on_event: impl FnMut(Event),
     ) {
         let line = Line::now(now_us, listener);
+        // Stream positions of the bytes given out, in order.
+        let mut position = listener.frames_heard();
         listener.push(now_us, byte, &mut |heard| {
-            self.on_heard(now_us, heard, line, config, &mut on_event);
+            let at = position;
+            if matches!(heard, Heard::Byte(_)) {
+                position = position.wrapping_add(1);
+            }
+            self.on_heard(now_us, heard, at, line, config, &mut on_event);
         });
+        self.follow_stream(listener, config, &mut on_event);
         let garbled = matches!(
             &self.current,
             Some(InFlight { stage: Stage::AwaitReply { reply_started: true, .. }, request, .. })
@@ -233,19 +357,104 @@ impl Forwarder {
 
     /// Acts on what the listener heard; `line` is what the line was like before the byte
     /// (or the time) that brought it.
+    /// `position` is the stream position of a [`Heard::Byte`].
     fn on_heard(
         &mut self,
         now_us: u64,
         heard: Heard,
+        position: u64,
         line: Line,
         config: &BasicConfig,
         on_event: &mut impl FnMut(Event),
     ) {
         match heard {
             Heard::Echo(echo) => self.on_echo(now_us, echo, line.echoes, config, on_event),
-            Heard::Byte(byte) => self.note_reply_byte(byte, line.silence_before),
+            Heard::Byte(byte) => {
+                self.heard_other = true;
+                self.note_reply_byte(byte, position, line.silence_before);
+            }
             Heard::Frame(frame) => self.on_frame(now_us, frame, on_event),
             Heard::Packet(_) => {}
+        }
+    }
+
+    /// Passes the reply on to the client as it arrives, for a request that allows it
+    /// ([`Request::cut_through`], and [`BasicConfig::cut_through`]). The reply is the frame candidate the listener is hearing
+    /// that began a transmission while the request waits for its reply, with the request's
+    /// CMD, a LEN pymycobot reads (up to [`MAX_STREAMED_LEN`]), and no CMD of a request given
+    /// up on (its late reply is told apart only once complete). Its bytes are passed on as
+    /// far as [`streamable_prefix`] allows; the frame completing ends it (the reply event
+    /// carries it), a candidate dropped cuts it ([`Event::ReplyCut`]).
+    fn follow_stream(
+        &mut self,
+        listener: &Listener,
+        config: &BasicConfig,
+        on_event: &mut impl FnMut(Event),
+    ) {
+        let Some(flight) = self.current.as_mut() else {
+            return;
+        };
+        let (start, candidate) = listener.frame_partial();
+        let origin = flight.request.origin;
+        if let Some(stream) = flight.stream.as_mut() {
+            if stream.start != start || candidate.is_empty() {
+                // Dropped without completing as the reply.
+                flight.stream = None;
+                on_event(Event::ReplyCut { origin });
+                return;
+            }
+            let upto = streamable_prefix(candidate, stream.len);
+            if upto > stream.given
+                && let Some(bytes) = candidate.get(stream.given..upto)
+            {
+                stream.given = upto;
+                on_event(Event::ReplyMore {
+                    origin,
+                    bytes: Vec::from_slice(bytes).unwrap_or_default(),
+                });
+            }
+            return;
+        }
+        let Stage::AwaitReply { burst_fe, .. } = flight.stage else {
+            return;
+        };
+        let cmd = flight.request.frame.cmd();
+        let &[HEADER, HEADER, len, code, ..] = candidate else {
+            return;
+        };
+        if !(config.cut_through && flight.request.cut_through)
+            || burst_fe != Some(start)
+            || code != cmd
+            || !(MIN_LEN..=MAX_STREAMED_LEN).contains(&len)
+            || self.late.iter().any(|late| late.request.frame.cmd() == cmd)
+        {
+            return;
+        }
+        let len = usize::from(len) + 3;
+        let upto = streamable_prefix(candidate, len);
+        let Some(head) = candidate.get(..upto) else {
+            return;
+        };
+        flight.stream = Some(Streamed {
+            start,
+            given: upto,
+            len,
+        });
+        on_event(Event::ReplyHead {
+            origin,
+            head: Vec::from_slice(head).unwrap_or_default(),
+            len,
+        });
+    }
+
+    /// Ends the reply being passed on, if any, without its end.
+    fn cut_stream(&mut self, on_event: &mut impl FnMut(Event)) {
+        if let Some(flight) = self.current.as_mut()
+            && flight.stream.take().is_some()
+        {
+            on_event(Event::ReplyCut {
+                origin: flight.request.origin,
+            });
         }
     }
 
@@ -286,20 +495,25 @@ impl Forwarder {
         }
     }
 
-    /// Notes a byte heard while waiting for the reply: whether a reply seems to have begun.
-    fn note_reply_byte(&mut self, byte: u8, silence_before: bool) {
+    /// Notes a byte heard while waiting for the reply, at stream position `position`: whether
+    /// a reply seems to have begun.
+    fn note_reply_byte(&mut self, byte: u8, position: u64, silence_before: bool) {
         if let Some(InFlight {
             stage:
                 Stage::AwaitReply {
                     heard_any,
                     last_fe,
                     reply_started,
+                    burst_fe,
                     ..
                 },
             ..
         }) = &mut self.current
         {
             let starts_transmission = !*heard_any || silence_before;
+            if byte == HEADER && starts_transmission {
+                *burst_fe = Some(position);
+            }
             *reply_started |= byte == HEADER && (starts_transmission || *last_fe);
             *last_fe = byte == HEADER && !*last_fe;
             *heard_any = true;
@@ -319,9 +533,15 @@ impl Forwarder {
         mut on_event: impl FnMut(Event),
     ) {
         let line = Line::now(now_us, listener);
+        let mut position = listener.frames_heard();
         listener.on_time(now_us, &mut |heard| {
-            self.on_heard(now_us, heard, line, config, &mut on_event);
+            let at = position;
+            if matches!(heard, Heard::Byte(_)) {
+                position = position.wrapping_add(1);
+            }
+            self.on_heard(now_us, heard, at, line, config, &mut on_event);
         });
+        self.follow_stream(listener, config, &mut on_event);
         while self
             .late
             .front()
@@ -351,8 +571,11 @@ impl Forwarder {
         }) = &self.current
             && now_us >= *deadline_us
             && let answer_heard = *reply_started
-            && let Some(done) = self.current.take()
         {
+            self.cut_stream(&mut on_event);
+            let Some(done) = self.current.take() else {
+                return;
+            };
             // Unless a garbled answer was heard, its reply may still come: recognised as
             // late, never taken for another's.
             if answer_heard {
@@ -378,6 +601,7 @@ impl Forwarder {
         config: &BasicConfig,
         on_event: &mut impl FnMut(Event),
     ) {
+        self.cut_stream(on_event);
         let Some(flight) = &mut self.current else {
             return;
         };
@@ -408,6 +632,7 @@ impl Forwarder {
                 heard_any: false,
                 last_fe: false,
                 reply_started: false,
+                burst_fe: None,
             };
         }
     }
@@ -566,6 +791,330 @@ mod tests {
         const { assert!(LATEST_START_IN_GAP_US > timing::BUS_QUIET_BEFORE_SEND_US) };
     }
 
+    /// A bus port that takes anything and is always idle.
+    #[derive(Default)]
+    struct Port(std::vec::Vec<u8>);
+
+    impl BytePort for Port {
+        fn read_byte(&mut self) -> Option<u8> {
+            None
+        }
+        fn write(&mut self, bytes: &[u8]) {
+            self.0.extend_from_slice(bytes);
+        }
+        fn tx_idle(&self) -> bool {
+            true
+        }
+    }
+
+    /// A forwarder whose request (`cmd`, a client's, passed on as it arrives if `cut_through`)
+    /// is on the bus and waits for its reply, on a line without echo; the time then, in us.
+    struct Waiting {
+        forwarder: Forwarder,
+        listener: Listener,
+        config: BasicConfig,
+        now_us: u64,
+        events: std::vec::Vec<Event>,
+    }
+
+    impl Waiting {
+        fn new(cmd: u8, cut_through: bool) -> Self {
+            let config = BasicConfig {
+                echo: EchoMode::Absent,
+                ..BasicConfig::default()
+            };
+            let mut waiting = Self {
+                forwarder: Forwarder::new(),
+                listener: bus_listener(EchoMode::Absent),
+                config,
+                now_us: 1_000,
+                events: std::vec::Vec::new(),
+            };
+            waiting.ask(cmd, cut_through);
+            waiting
+        }
+
+        /// Sends a client's request `cmd` on a quiet wire and lets its transmission end.
+        fn ask(&mut self, cmd: u8, cut_through: bool) {
+            let client = crate::request::Client::new(crate::request::LinkId::USB, 0);
+            self.forwarder.start(Request {
+                frame: Frame::new(cmd, &[]).unwrap(),
+                origin: Origin::Host(client),
+                answer: protocol_core::dialect::Answer::AsIs,
+                queued_us: 0,
+                cut_through,
+            });
+            self.now_us += ATOM_START_SEEN_US;
+            let mut port = Port::default();
+            self.forwarder
+                .try_send(self.now_us, &mut port, &mut self.listener);
+            assert_eq!(port.0.len(), 5, "sent");
+            self.idle(100);
+        }
+
+        /// Bytes from the Atom, one per byte time at 1 Mbaud.
+        fn hear(&mut self, bytes: &[u8]) {
+            for &b in bytes {
+                self.now_us += 10;
+                let events = &mut self.events;
+                self.forwarder
+                    .on_bus_byte(self.now_us, b, &mut self.listener, &self.config, |e| {
+                        events.push(e)
+                    });
+            }
+        }
+
+        /// `us` of quiet.
+        fn idle(&mut self, us: u64) {
+            self.now_us += us;
+            let events = &mut self.events;
+            self.forwarder.on_time(
+                self.now_us,
+                &Port::default(),
+                &mut self.listener,
+                &self.config,
+                |e| events.push(e),
+            );
+        }
+
+        /// What was passed on to the client before the reply's end, and how that ended: the
+        /// bytes given, and whether the reply completed it (`Some(true)`) or it was cut.
+        fn passed_on(&self) -> (std::vec::Vec<u8>, Option<bool>) {
+            let mut given = std::vec::Vec::new();
+            let mut end = None;
+            let mut open = false;
+            for e in &self.events {
+                match e {
+                    Event::ReplyHead { head, len, .. } => {
+                        assert_eq!(*len, usize::from(head[2]) + 3);
+                        given.extend_from_slice(head);
+                        open = true;
+                    }
+                    Event::ReplyMore { bytes, .. } => {
+                        assert!(open, "more without a head");
+                        given.extend_from_slice(bytes);
+                    }
+                    Event::ReplyCut { .. } if open => (end, open) = (Some(false), false),
+                    Event::Reply { .. } if open => (end, open) = (Some(true), false),
+                    _ => {}
+                }
+            }
+            (given, end)
+        }
+
+        fn replies(&self) -> std::vec::Vec<Frame> {
+            self.events
+                .iter()
+                .filter_map(|e| match e {
+                    Event::Reply { reply, .. } => Some(reply.clone()),
+                    _ => None,
+                })
+                .collect()
+        }
+    }
+
+    fn angles() -> std::vec::Vec<u8> {
+        Frame::new(
+            cmd::GET_ANGLES,
+            &[0, 100, 0xFF, 0x9C, 0, 0, 0, 0, 0x12, 0x34, 0xFE, 0xFA],
+        )
+        .unwrap()
+        .to_bytes()
+        .to_vec()
+    }
+
+    #[test]
+    fn a_reply_is_passed_on_from_its_cmd_on_but_its_last_byte_only_as_the_frame() {
+        let mut w = Waiting::new(cmd::GET_ANGLES, true);
+        let reply = angles();
+        w.hear(&reply[..3]);
+        assert!(w.events.is_empty(), "nothing before the CMD is known");
+        w.hear(&reply[3..4]);
+        assert!(
+            matches!(&w.events[..], [Event::ReplyHead { head, len: 17, .. }] if head[..] == reply[..4])
+        );
+        w.hear(&reply[4..]);
+        let (given, end) = w.passed_on();
+        assert_eq!(
+            given,
+            reply[..reply.len() - 1],
+            "all but the FA before the frame"
+        );
+        assert_eq!(end, Some(true));
+        assert_eq!(w.replies().len(), 1);
+    }
+
+    #[test]
+    fn a_reply_cut_short_by_silence_or_not_ending_in_fa_is_cut() {
+        let reply = angles();
+        let mut w = Waiting::new(cmd::GET_ANGLES, true);
+        w.hear(&reply[..9]);
+        w.idle(timing::BUS_FRAME_GAP_US);
+        assert_eq!(w.passed_on(), (reply[..9].to_vec(), Some(false)));
+        let mut w = Waiting::new(cmd::GET_ANGLES, true);
+        let mut garbled = reply.clone();
+        garbled[16] = 0x00;
+        w.hear(&garbled);
+        assert_eq!(w.passed_on(), (reply[..16].to_vec(), Some(false)));
+        assert!(w.replies().is_empty());
+        // The Atom sends it again (its own echo showed the collision): passed on afresh.
+        w.idle(timing::BUS_QUIET_BEFORE_SEND_US);
+        w.hear(&reply);
+        assert_eq!(w.replies().len(), 1);
+        assert_eq!(
+            w.events
+                .iter()
+                .filter(|e| matches!(e, Event::ReplyHead { .. }))
+                .count(),
+            2
+        );
+    }
+
+    #[test]
+    fn nothing_of_an_fe_fe_inside_the_reply_is_passed_on_before_the_frame() {
+        assert_eq!(
+            streamable_prefix(&[0xFE, 0xFE, 0x04, 0x20, 0x01, 0xFE], 7),
+            6
+        );
+        assert_eq!(
+            streamable_prefix(&[0xFE, 0xFE, 0x06, 0x20, 0x01, 0xFE, 0xFE, 0x02], 9),
+            6
+        );
+        assert_eq!(streamable_prefix(&[0xFE, 0xFE, 0x03, 0xFE, 0xFE], 6), 4);
+        assert_eq!(
+            streamable_prefix(&[0xFE, 0xFE, 0x02, 0x20, 0xFA], 5),
+            4,
+            "never the FA"
+        );
+        let mut w = Waiting::new(cmd::GET_ANGLES, true);
+        let reply = Frame::new(
+            cmd::GET_ANGLES,
+            &[1, 0xFE, 0xFE, 0x02, 0x20, 0xFA, 0, 0, 0, 0, 0, 0],
+        )
+        .unwrap()
+        .to_bytes();
+        w.hear(&reply);
+        let (given, end) = w.passed_on();
+        assert_eq!(given, reply[..6], "up to the first FE of the pair");
+        assert_eq!(end, Some(true));
+    }
+
+    #[test]
+    fn only_a_reply_that_may_and_can_be_is_passed_on_as_it_arrives() {
+        let reply = angles();
+        // A request whose client may not get it so (a network link, another dialect).
+        let mut w = Waiting::new(cmd::GET_ANGLES, false);
+        w.hear(&reply);
+        assert_eq!(w.passed_on(), (std::vec::Vec::new(), None));
+        assert_eq!(w.replies().len(), 1);
+        // Cut-through off in the config.
+        let mut w = Waiting::new(cmd::GET_ANGLES, true);
+        w.config.cut_through = false;
+        w.hear(&reply);
+        assert_eq!(w.passed_on(), (std::vec::Vec::new(), None));
+        // Another command's frame, a LEN pymycobot does not read.
+        let mut w = Waiting::new(cmd::GET_ANGLES, true);
+        w.hear(&Frame::new(cmd::IS_POWER_ON, &[1]).unwrap().to_bytes());
+        let long = Frame::new(cmd::GET_ANGLES, &[0; 29]).unwrap().to_bytes();
+        w.idle(100);
+        w.hear(&long);
+        assert_eq!(w.passed_on(), (std::vec::Vec::new(), None));
+        // A frame that does not begin a transmission (right behind other bytes).
+        let mut w = Waiting::new(cmd::GET_ANGLES, true);
+        let mut behind = std::vec![0x11, 0x22];
+        behind.extend_from_slice(&reply);
+        w.hear(&behind);
+        assert_eq!(w.passed_on(), (std::vec::Vec::new(), None));
+        assert_eq!(w.replies().len(), 1, "still the reply, whole");
+    }
+
+    #[test]
+    fn a_reply_that_may_be_a_late_one_is_not_passed_on_before_it_is_whole() {
+        let mut w = Waiting::new(cmd::GET_ANGLES, true);
+        w.idle(BasicConfig::default().reply_timeout_us);
+        assert!(matches!(w.events.last(), Some(Event::Timeout(_))));
+        // The next request asks the same; the first one's answer comes now.
+        w.ask(cmd::GET_ANGLES, true);
+        w.events.clear();
+        w.hear(&angles());
+        assert_eq!(w.passed_on(), (std::vec::Vec::new(), None));
+        assert_eq!(
+            w.replies().len(),
+            1,
+            "a resend of the same question: its answer"
+        );
+    }
+
+    /// An idle forwarder whose listener last heard another station's byte at `t_us`.
+    fn idle_after_a_byte_at(t_us: u64) -> (Forwarder, Listener, BasicConfig) {
+        let mut forwarder = Forwarder::new();
+        let mut listener = bus_listener(EchoMode::Absent);
+        let config = BasicConfig::default();
+        forwarder.on_bus_byte(t_us, 0xFF, &mut listener, &config, |_| {});
+        (forwarder, listener, config)
+    }
+
+    #[test]
+    fn the_bus_is_held_only_early_in_the_atoms_gap() {
+        for quiet_us in 0..200 {
+            let (mut forwarder, mut listener, config) = idle_after_a_byte_at(1_000);
+            let mut port = Port::default();
+            forwarder.hold(1_000 + quiet_us, &mut port, &mut listener, true, &config);
+            let early =
+                (timing::BUS_QUIET_BEFORE_SEND_US..LATEST_START_IN_GAP_US).contains(&quiet_us);
+            let expected: &[u8] = if early { &[HOLD_BYTE] } else { &[] };
+            assert_eq!(port.0, expected, "quiet {quiet_us} us");
+        }
+    }
+
+    #[test]
+    fn the_bus_is_held_only_for_a_request_coming_while_idle_and_if_configured() {
+        let early = 1_000 + timing::BUS_QUIET_BEFORE_SEND_US;
+        let (mut forwarder, mut listener, config) = idle_after_a_byte_at(1_000);
+        let mut port = Port::default();
+        forwarder.hold(early, &mut port, &mut listener, false, &config);
+        let off = BasicConfig {
+            bus_hold: false,
+            ..config
+        };
+        forwarder.hold(early, &mut port, &mut listener, true, &off);
+        assert!(port.0.is_empty(), "nothing coming, or holding off");
+        let mut w = Waiting::new(cmd::GET_ANGLES, true);
+        let quiet_since = w.now_us;
+        w.forwarder.hold(
+            quiet_since + 65,
+            &mut port,
+            &mut w.listener,
+            true,
+            &w.config,
+        );
+        assert!(port.0.is_empty(), "a request in flight");
+    }
+
+    #[test]
+    fn holds_alternate_with_another_stations_turn() {
+        let (mut forwarder, mut listener, config) = idle_after_a_byte_at(1_000);
+        let mut port = Port::default();
+        // A poll at `t`: time passes (echo verdicts), then the hold.
+        let poll = |t: u64, coming: bool, f: &mut Forwarder, l: &mut Listener, p: &mut Port| {
+            f.on_time(t, &*p, l, &config, |_| {});
+            f.hold(t, p, l, coming, &config);
+        };
+        // A hold: a byte early in each gap while the request comes.
+        poll(1_065, true, &mut forwarder, &mut listener, &mut port);
+        poll(1_140, true, &mut forwarder, &mut listener, &mut port);
+        assert_eq!(port.0, [HOLD_BYTE; 2]);
+        // It was no request after all (the frame failed): the hold ends. The next one waits
+        // for another station's turn on the bus.
+        poll(1_215, false, &mut forwarder, &mut listener, &mut port);
+        poll(1_290, true, &mut forwarder, &mut listener, &mut port);
+        poll(1_365, true, &mut forwarder, &mut listener, &mut port);
+        assert_eq!(port.0.len(), 2, "no hold before the Atom had its turn");
+        forwarder.on_bus_byte(1_400, 0xFF, &mut listener, &config, |_| {});
+        poll(1_465, true, &mut forwarder, &mut listener, &mut port);
+        assert_eq!(port.0.len(), 3, "after it");
+    }
+
     #[test]
     fn only_the_basics_own_requests_are_ever_sent_again() {
         let request = |origin| Request {
@@ -573,6 +1122,7 @@ mod tests {
             origin,
             answer: protocol_core::dialect::Answer::AsIs,
             queued_us: 0,
+            cut_through: false,
         };
         let client = crate::request::Client::new(crate::request::LinkId::USB, 0);
         assert!(!may_resend(&request(Origin::Host(client))));

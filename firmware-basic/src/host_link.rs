@@ -3,8 +3,9 @@
 //! gap for truncated frames) and queues bytes for the client without ever blocking the loop.
 
 use heapless::{Deque, Vec};
+use protocol_core::command::is_basic_local;
 use protocol_core::dialect::Dialect;
-use protocol_core::frame::{MAX_FRAME_BYTES, MIN_LEN};
+use protocol_core::frame::{HEADER, MAX_FRAME_BYTES, MAX_LEN, MIN_FRAME_BYTES, MIN_LEN};
 use protocol_core::listener::{Heard, Listener, ListenerConfig};
 use protocol_core::{Frame, timing};
 
@@ -13,8 +14,15 @@ use protocol_core::{Frame, timing};
 /// transparent mode a busy bus (1 Mbaud) outpaces the host link and the oldest bytes go.
 pub const HOST_TX_CAPACITY: usize = 512;
 /// Most bytes handed to the host port in one write: well under the ESP32 UART's 128-byte FIFO,
-/// so a write into an idle transmitter never waits.
+/// so a write into an idle transmitter never waits. It also bounds what a reply passed on as
+/// it arrives (`HostLink::stream_open`) hands a busy port since it was last idle, so those
+/// writes never wait either.
 pub const HOST_WRITE_CHUNK: usize = 64;
+
+/// What stands in the queue for the bytes of a reply passed on as it arrives that are not in
+/// yet, and stays there if the reply never completes: neither `FE` (it cannot start a frame)
+/// nor `FA` (the last byte of the reply's place is then no frame's end).
+pub const STREAM_FILLER: u8 = 0x00;
 /// Most bytes taken from one host link per poll, so one poll stays short whatever the clients
 /// send.
 pub const HOST_READ_BUDGET: usize = 64;
@@ -34,6 +42,12 @@ pub const NETWORK_TEXT_GAP_US: u64 = 5_000;
 /// How long pymycobot's socket client waits for a reply before it sends again, in microseconds
 /// (`MyCobot280Socket`: 0.3 s per try; the serial client waits 0.5 s).
 pub const NETWORK_REPLY_DEADLINE_US: u64 = 300_000;
+
+/// Most bytes a request may still have to come, at the line's speed, for the bus to be held
+/// for it (`HostLink::request_coming`): 8, 0.69 ms at 115200. A `get_angles` (5 bytes) is
+/// held for from its first byte; a longer request from its last 8. It bounds how long the
+/// Atom's servo refresh waits for one request.
+pub const HOLD_MAX_REMAINING_BYTES: usize = 8;
 
 /// What a host link is, which sets its timing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -94,6 +108,17 @@ pub const MAX_FRAMES_AT_ONCE: usize = MAX_FRAME_BYTES / (3 + MIN_LEN as usize);
 /// The frames one host byte or one quiet gap completed, in order.
 pub(crate) type HostFrames = Vec<Frame, MAX_FRAMES_AT_ONCE>;
 
+/// FNV-1a's starting value.
+const FNV_OFFSET: u32 = 0x811C_9DC5;
+
+/// `bytes` folded into `hash` by FNV-1a: what the bytes of a reply passed on are checked by,
+/// without keeping them.
+fn digest(hash: u32, bytes: &[u8]) -> u32 {
+    bytes
+        .iter()
+        .fold(hash, |h, &b| (h ^ u32::from(b)).wrapping_mul(0x0100_0193))
+}
+
 /// A host link: a listener for what arrives and a bounded queue for what leaves.
 #[derive(Debug)]
 pub(crate) struct HostLink {
@@ -102,6 +127,32 @@ pub(crate) struct HostLink {
     /// The dialect its frames are read in ([`Self::adopt`]).
     dialect: Dialect,
     tx: Deque<u8, HOST_TX_CAPACITY>,
+    /// The place in `tx` of a reply passed on as it arrives, until its last byte has left.
+    stream: Option<Stream>,
+    /// Bytes handed to the port since it was last seen idle.
+    since_idle: usize,
+}
+
+/// The place of a reply passed on to the client as it arrives on the bus (cut-through): its
+/// whole length is reserved in the queue when it opens, so nothing queued later can get into
+/// it, and the port is handed only the part that has arrived. See [`HostLink::stream_open`].
+#[derive(Debug)]
+struct Stream {
+    /// Bytes queued ahead of it.
+    ahead: usize,
+    /// Its bytes still in the queue.
+    len: usize,
+    /// How many of those are ready for the port (the rest are [`STREAM_FILLER`] standing in
+    /// for bytes still to come).
+    ready: usize,
+    /// How many of its bytes were given so far, and their digest ([`digest`]), to check the
+    /// frame that completes it against.
+    given: usize,
+    given_digest: u32,
+    /// Its whole length.
+    total: usize,
+    /// Still taking bytes (neither completed nor cut).
+    open: bool,
 }
 
 impl HostLink {
@@ -112,6 +163,8 @@ impl HostLink {
             rx: Listener::new(kind.listener()),
             dialect: Dialect::Pymycobot,
             tx: Deque::new(),
+            stream: None,
+            since_idle: 0,
         }
     }
 
@@ -130,6 +183,33 @@ impl HostLink {
     /// Microseconds since the last host byte arrived.
     pub(crate) fn quiet_for_us(&self, now_us: u64) -> u64 {
         self.rx.quiet_us(now_us)
+    }
+
+    /// True if a request for the Atom seems to be arriving on this link at `now_us`, with at
+    /// most [`HOLD_MAX_REMAINING_BYTES`] still to come: a serial link in pymycobot's dialect
+    /// whose frame in progress has a header that can be a frame's (`FE`, `FE FE`, a LEN from
+    /// `MIN_LEN` to `MAX_LEN`, a CMD that is not one of the Basic's own), whose last byte came
+    /// within two byte times (the client is still sending it, back to back), and whose LEN (a
+    /// shortest frame while it is not in yet) leaves few bytes to come. The Basic holds the bus
+    /// for it ([`crate::forwarder::Forwarder::hold`]).
+    pub(crate) fn request_coming(&self, now_us: u64) -> bool {
+        if self.kind != LinkKind::Serial || self.dialect != Dialect::Pymycobot {
+            return false;
+        }
+        let (_, partial) = self.rx.frame_partial();
+        let length = match partial {
+            [HEADER] | [HEADER, HEADER] => MIN_FRAME_BYTES,
+            [HEADER, HEADER, len, rest @ ..] if (MIN_LEN..=MAX_LEN).contains(len) => {
+                if rest.first().is_some_and(|&cmd| is_basic_local(cmd)) {
+                    return false;
+                }
+                3 + usize::from(*len)
+            }
+            _ => return false,
+        };
+        let byte_us = timing::wire_time_us(1, timing::HOST_BAUD);
+        self.rx.quiet_us(now_us) <= 2 * byte_us
+            && length.saturating_sub(partial.len()) <= HOLD_MAX_REMAINING_BYTES
     }
 
     /// Drops a partial frame once the client has been quiet for the link's gap (it was cut
@@ -189,7 +269,7 @@ impl HostLink {
     /// full: a raw tool needs the newest traffic (its servo's answer), not the stale backlog.
     /// False if a byte was dropped.
     pub(crate) fn send_raw(&mut self, byte: u8) -> bool {
-        let dropped = self.tx.is_full() && self.tx.pop_front().is_some();
+        let dropped = self.tx.is_full() && self.pop_front().is_some();
         // Cannot fail: there is room now.
         let _ = self.tx.push_back(byte);
         !dropped
@@ -198,24 +278,163 @@ impl HostLink {
     /// Forgets every byte not yet handed to the host port.
     pub(crate) fn clear_tx(&mut self) {
         self.tx.clear();
+        self.stream = None;
+    }
+
+    /// Starts passing a reply on as it arrives (cut-through): `head`, its first bytes, are
+    /// queued now, and its whole length `len` (`FE FE LEN` + LEN) is reserved behind them, so
+    /// what is queued later waits behind the whole reply. The port gets its bytes as they are
+    /// given ([`Self::stream_more`]), up to the last one, which only [`Self::stream_finish`]
+    /// writes once the whole frame is known good. A reply that never completes
+    /// ([`Self::stream_cut`]) leaves [`STREAM_FILLER`] in the rest of its place, so the client
+    /// sees a frame whose last byte is not `FA`: no frame. Serial links only (a network client
+    /// takes one segment as a whole reply). False, and nothing queued, if that cannot be: not a
+    /// serial link, another reply still open, `head` not shorter than `len`, no room.
+    pub(crate) fn stream_open(&mut self, head: &[u8], len: usize) -> bool {
+        let fits = HOST_TX_CAPACITY - self.tx.len() >= len;
+        if self.kind != LinkKind::Serial
+            || self.stream.as_ref().is_some_and(|s| s.open)
+            || head.len() >= len
+            || len > MAX_FRAME_BYTES
+            || !fits
+        {
+            return false;
+        }
+        // The last one, completed but not all gone yet, is just bytes in the queue now.
+        self.stream = None;
+        let ahead = self.tx.len();
+        for i in 0..len {
+            // Cannot fail: room was checked above.
+            let _ = self
+                .tx
+                .push_back(head.get(i).copied().unwrap_or(STREAM_FILLER));
+        }
+        self.stream = Some(Stream {
+            ahead,
+            len,
+            ready: head.len(),
+            given: head.len(),
+            given_digest: digest(FNV_OFFSET, head),
+            total: len,
+            open: true,
+        });
+        true
+    }
+
+    /// Gives the open reply its next bytes (never its last one: the place of that byte is left
+    /// to [`Self::stream_finish`]); no-op without an open reply.
+    pub(crate) fn stream_more(&mut self, bytes: &[u8]) {
+        let Some(stream) = self.stream.as_mut().filter(|s| s.open) else {
+            return;
+        };
+        for &b in bytes {
+            if stream.given + 1 >= stream.total {
+                break;
+            }
+            // The reply's bytes still queued: its first `len` of `total` are the last ones.
+            let index = stream.ahead + stream.ready;
+            if let Some(slot) = self.tx.get_mut(index) {
+                *slot = b;
+            }
+            stream.ready += 1;
+            stream.given += 1;
+            stream.given_digest = digest(stream.given_digest, &[b]);
+        }
+    }
+
+    /// Completes the open reply with `frame`, the frame it turned out to be: true if its bytes
+    /// so far were `frame`'s first bytes (the rest goes into its place). False, with the reply
+    /// cut ([`Self::stream_cut`]), if they were not, or if no reply is open: the caller queues
+    /// `frame` whole.
+    pub(crate) fn stream_finish(&mut self, frame: &Frame) -> bool {
+        let Some(stream) = self.stream.as_mut().filter(|s| s.open) else {
+            return false;
+        };
+        let bytes = frame.to_bytes();
+        let given = bytes.get(..stream.given).unwrap_or_default();
+        if bytes.len() != stream.total || digest(FNV_OFFSET, given) != stream.given_digest {
+            self.stream_cut();
+            return false;
+        }
+        let done = stream.total - stream.len;
+        for (i, &b) in bytes.iter().enumerate().skip(stream.given) {
+            // The reply's byte i is at queue index ahead + (i - done) while it is queued.
+            if let Some(slot) = i
+                .checked_sub(done)
+                .and_then(|k| self.tx.get_mut(stream.ahead + k))
+            {
+                *slot = b;
+            }
+        }
+        stream.ready = stream.len;
+        stream.open = false;
+        true
+    }
+
+    /// Ends the open reply without its end: what was not given stays [`STREAM_FILLER`], so the
+    /// client decodes no frame from it (no `FE FE` was given inside it: see the forwarder).
+    pub(crate) fn stream_cut(&mut self) {
+        if let Some(stream) = self.stream.as_mut().filter(|s| s.open) {
+            stream.ready = stream.len;
+            stream.open = false;
+        }
+    }
+
+    /// Takes the oldest queued byte, keeping the open reply's place in step.
+    fn pop_front(&mut self) -> Option<u8> {
+        let byte = self.tx.pop_front()?;
+        if let Some(stream) = self.stream.as_mut() {
+            if stream.ahead > 0 {
+                stream.ahead -= 1;
+            } else {
+                stream.len = stream.len.saturating_sub(1);
+                stream.ready = stream.ready.saturating_sub(1);
+            }
+            if stream.len == 0 {
+                // All of it has left (or was pushed out): nothing to keep in step any more.
+                self.stream = None;
+            }
+        }
+        Some(byte)
     }
 
     /// Takes up to [`HOST_WRITE_CHUNK`] queued bytes for the port, once its transmitter is
-    /// `idle`; `None` if there is nothing to hand over now.
+    /// `idle`; `None` if there is nothing to hand over now. A reply passed on as it arrives
+    /// ([`Self::stream_open`]) is handed over only as far as it has arrived, and once it is at
+    /// the front of the queue its bytes follow each other into a busy port too, up to
+    /// [`HOST_WRITE_CHUNK`] bytes since the port was last idle (the UART's FIFO takes them
+    /// without waiting, and the wire carries them without a gap).
     pub(crate) fn next_chunk(&mut self, idle: bool) -> Option<Vec<u8, HOST_WRITE_CHUNK>> {
-        if self.tx.is_empty() || !idle {
+        if idle {
+            self.since_idle = 0;
+        }
+        // What may go now, and how much of it into a busy port: the reply's bytes once
+        // everything ahead of it has gone.
+        let (ready, busy_ok) = match &self.stream {
+            Some(s) if s.open => (s.ahead + s.ready, if s.ahead == 0 { s.ready } else { 0 }),
+            Some(s) => (self.tx.len(), if s.ahead == 0 { s.len } else { 0 }),
+            None => (self.tx.len(), 0),
+        };
+        let allowed = if idle {
+            HOST_WRITE_CHUNK
+        } else {
+            busy_ok.min(HOST_WRITE_CHUNK.saturating_sub(self.since_idle))
+        };
+        let n = ready.min(allowed);
+        if n == 0 {
             return None;
         }
         let mut chunk = Vec::new();
-        while !chunk.is_full() {
-            match self.tx.pop_front() {
-                // Cannot fail: the chunk is not full.
+        for _ in 0..n {
+            match self.pop_front() {
+                // Cannot fail: n <= HOST_WRITE_CHUNK, the chunk's capacity.
                 Some(b) => {
                     let _ = chunk.push(b);
                 }
                 None => break,
             }
         }
+        self.since_idle += chunk.len();
         Some(chunk)
     }
 }
@@ -364,6 +583,209 @@ mod tests {
             expected,
             "the oldest went, the newest stayed"
         );
+    }
+
+    #[test]
+    fn a_request_is_coming_while_a_plausible_frame_arrives_with_few_bytes_to_go() {
+        let byte = timing::wire_time_us(1, timing::HOST_BAUD);
+        // Each prefix of a frame, heard at line speed: is a request coming right after it?
+        let coming_after = |bytes: &[u8], kind: LinkKind| {
+            let mut link = HostLink::new(kind);
+            hear_all(&mut link, 0, bytes);
+            let last = byte * (bytes.len() as u64 - 1);
+            link.request_coming(last + byte)
+        };
+        for n in 1..GET_ANGLES.len() {
+            assert!(
+                coming_after(&GET_ANGLES[..n], LinkKind::Serial),
+                "{n} bytes in"
+            );
+            assert!(
+                !coming_after(&GET_ANGLES[..n], LinkKind::Network),
+                "a network link"
+            );
+        }
+        assert!(
+            !coming_after(&GET_ANGLES, LinkKind::Serial),
+            "in: no longer coming"
+        );
+        // The Basic's own command (0xC1), and a LEN no frame has.
+        assert!(!coming_after(&[0xFE, 0xFE, 0x02, 0xC1], LinkKind::Serial));
+        assert!(!coming_after(&[0xFE, 0xFE, 0x41], LinkKind::Serial));
+        // A long frame: only its last 8 bytes.
+        let mut send_angles = std::vec![0xFE, 0xFE, 0x0F, 0x22];
+        send_angles.extend_from_slice(&[0; 13]);
+        assert!(!coming_after(&send_angles[..9], LinkKind::Serial));
+        assert!(coming_after(&send_angles[..10], LinkKind::Serial));
+        // A client that stopped sending mid-frame.
+        let mut link = HostLink::new(LinkKind::Serial);
+        hear_all(&mut link, 0, &GET_ANGLES[..2]);
+        assert!(link.request_coming(byte * 2));
+        assert!(
+            !link.request_coming(byte * 4),
+            "quiet for over two byte times"
+        );
+        // Another dialect reads other lengths.
+        let mut link = HostLink::new(LinkKind::Serial);
+        assert!(link.adopt(Dialect::Seed));
+        hear_all(&mut link, 0, &GET_ANGLES[..2]);
+        assert!(!link.request_coming(byte * 2));
+    }
+
+    /// `get_angles`' reply as the Atom sends it.
+    fn angles_reply() -> std::vec::Vec<u8> {
+        Frame::new(
+            0x20,
+            &[0, 100, 0xFF, 0x9C, 0, 0, 0, 0, 0x12, 0x34, 0xFE, 0xFA],
+        )
+        .unwrap()
+        .to_bytes()
+        .to_vec()
+    }
+
+    #[test]
+    fn a_reply_passed_on_as_it_arrives_goes_out_only_as_far_as_it_has_arrived() {
+        let mut link = HostLink::new(LinkKind::Serial);
+        let reply = angles_reply();
+        assert!(link.stream_open(&reply[..4], reply.len()));
+        assert_eq!(drain(&mut link), reply[..4], "the head at once");
+        link.stream_more(&reply[4..10]);
+        assert_eq!(drain(&mut link), reply[4..10]);
+        // Never the last byte: only the frame, once known whole, completes it.
+        link.stream_more(&reply[10..]);
+        assert_eq!(drain(&mut link), reply[10..reply.len() - 1]);
+        let frame = Frame::new(0x20, &reply[4..reply.len() - 1]).unwrap();
+        assert!(link.stream_finish(&frame));
+        assert_eq!(drain(&mut link), [0xFA]);
+        assert!(link.next_chunk(true).is_none());
+    }
+
+    #[test]
+    fn what_is_queued_behind_a_reply_passed_on_waits_for_its_end() {
+        let mut link = HostLink::new(LinkKind::Serial);
+        let reply = angles_reply();
+        assert!(link.stream_open(&reply[..4], reply.len()));
+        // An answer of the Basic's own to the same client, queued meanwhile.
+        let own = Frame::new(0xC1, &[10]).unwrap();
+        assert!(link.send_frame(&own));
+        let mut got = drain(&mut link);
+        assert_eq!(got, reply[..4], "not into the middle of the reply");
+        link.stream_more(&reply[4..]);
+        assert!(link.stream_finish(&Frame::new(0x20, &reply[4..reply.len() - 1]).unwrap()));
+        got.extend(drain(&mut link));
+        let mut expected = reply.clone();
+        expected.extend_from_slice(&own.to_bytes());
+        assert_eq!(got, expected);
+    }
+
+    #[test]
+    fn a_reply_cut_short_leaves_the_client_no_frame() {
+        let reply = angles_reply();
+        for cut_after in 4..reply.len() - 1 {
+            let mut link = HostLink::new(LinkKind::Serial);
+            assert!(link.stream_open(&reply[..4], reply.len()));
+            link.stream_more(&reply[4..cut_after]);
+            link.stream_cut();
+            // What follows is the next reply.
+            assert!(link.send_bytes(&reply));
+            let got = drain(&mut link);
+            assert_eq!(got.len(), 2 * reply.len(), "its whole place, then the next");
+            assert_eq!(got[..cut_after], reply[..cut_after]);
+            assert!(
+                got[cut_after..reply.len()]
+                    .iter()
+                    .all(|&b| b == STREAM_FILLER),
+                "{got:02x?}"
+            );
+            let mut frames = std::vec::Vec::new();
+            protocol_core::FrameDecoder::new().feed(&got, |f| frames.push(f));
+            assert_eq!(frames.len(), 1, "cut after {cut_after}: {frames:?}");
+            assert_eq!(frames[0].to_bytes().as_slice(), reply.as_slice());
+        }
+    }
+
+    #[test]
+    fn a_reply_that_turns_out_another_frame_is_cut_and_the_frame_goes_whole() {
+        let mut link = HostLink::new(LinkKind::Serial);
+        let reply = angles_reply();
+        assert!(link.stream_open(&reply[..4], reply.len()));
+        link.stream_more(&reply[4..8]);
+        let other = Frame::new(0x20, &[9; 12]).unwrap();
+        assert!(!link.stream_finish(&other), "its start differs");
+        assert!(link.send_frame(&other));
+        let got = drain(&mut link);
+        assert_eq!(got[reply.len()..], other.to_bytes()[..]);
+        assert!(!link.stream_finish(&other), "nothing open any more");
+    }
+
+    #[test]
+    fn a_reply_is_passed_on_only_on_a_serial_link_and_only_one_at_a_time() {
+        let reply = angles_reply();
+        let mut link = HostLink::new(LinkKind::Network);
+        assert!(
+            !link.stream_open(&reply[..4], reply.len()),
+            "a segment is a reply"
+        );
+        let mut link = HostLink::new(LinkKind::Serial);
+        assert!(
+            !link.stream_open(&reply, reply.len()),
+            "the head is not the whole"
+        );
+        assert!(link.stream_open(&reply[..4], reply.len()));
+        assert!(!link.stream_open(&reply[..4], reply.len()));
+        link.stream_cut();
+        assert!(link.stream_open(&reply[..4], reply.len()), "after the cut");
+        let mut full = HostLink::new(LinkKind::Serial);
+        assert!(full.send_bytes(&[0x55; HOST_TX_CAPACITY - 10]));
+        assert!(
+            !full.stream_open(&reply[..4], reply.len()),
+            "no room for its place"
+        );
+    }
+
+    #[test]
+    fn a_reply_passed_on_follows_itself_into_a_busy_port_but_nothing_else_does() {
+        let mut link = HostLink::new(LinkKind::Serial);
+        let reply = angles_reply();
+        assert!(link.send_bytes(&[1, 2, 3]));
+        assert!(link.stream_open(&reply[..4], reply.len()));
+        // The port is busy before anything was handed to it since it was idle: wait.
+        assert!(link.next_chunk(false).is_none());
+        let first = link.next_chunk(true).unwrap();
+        assert_eq!(
+            first.as_slice(),
+            &[&[1, 2, 3][..], &reply[..4]].concat()[..]
+        );
+        link.stream_more(&reply[4..6]);
+        let more = link
+            .next_chunk(false)
+            .expect("the reply goes on into the busy port");
+        assert_eq!(more.as_slice(), &reply[4..6]);
+        link.stream_more(&reply[6..]);
+        assert!(link.stream_finish(&Frame::new(0x20, &reply[4..reply.len() - 1]).unwrap()));
+        assert!(link.send_bytes(&[7]));
+        let rest = link.next_chunk(false).unwrap();
+        assert_eq!(rest.as_slice(), &reply[6..], "its end too");
+        assert!(
+            link.next_chunk(false).is_none(),
+            "what follows waits for an idle port"
+        );
+        assert_eq!(link.next_chunk(true).unwrap().as_slice(), &[7]);
+    }
+
+    #[test]
+    fn a_busy_port_is_handed_at_most_a_chunk_since_it_was_last_idle() {
+        let mut link = HostLink::new(LinkKind::Serial);
+        let long = Frame::new(0x20, &[7; protocol_core::frame::MAX_DATA]).unwrap();
+        let bytes = long.to_bytes();
+        assert!(link.stream_open(&bytes[..4], bytes.len()));
+        let mut handed = link.next_chunk(true).unwrap().len();
+        link.stream_more(&bytes[4..]);
+        while let Some(chunk) = link.next_chunk(false) {
+            handed += chunk.len();
+        }
+        assert_eq!(handed, HOST_WRITE_CHUNK, "the FIFO never fills");
+        assert!(link.next_chunk(true).is_some(), "the rest once idle");
     }
 
     #[test]

@@ -32,7 +32,12 @@
 //!   collisions the echo proves retried; a client's request is otherwise never sent twice.
 //!   Only the reply with the request's CMD comes back, a request the Atom does not answer is
 //!   given up after [`BasicConfig::reply_timeout_us`] (below pymycobot's 0.5 s resend), and
-//!   its late reply is dropped, never taken for another request's.
+//!   its late reply is dropped, never taken for another request's. While a request is still
+//!   arriving on a serial link, the Basic holds the bus with a `00` byte early in each of the
+//!   Atom's gaps ([`forwarder::HOLD_BYTE`]), so the request goes as soon as it is in. A serial
+//!   client's reply
+//!   is passed on as it arrives (cut-through, all but its last byte before it is whole); one
+//!   cut short leaves the client a frame header whose frame ends in filler, no frame.
 //! * [`transparent`]: after `0xC2 01` raw bytes go both ways (the Basic's echo removed)
 //!   between the bus and the client that switched, until it sends exactly
 //!   `FE FE 03 C2 00 FA` (or leaves); only that and the exact mode frames `FE FE 03 C2 01 FA`
@@ -42,7 +47,9 @@
 //!   the Basic made up could be read as a value). The switch waits for the request on the bus
 //!   to be answered; requests still waiting are dropped.
 //! * [`host_link`]: one link's framing (a frame cut by its link's quiet gap is dropped) and a
-//!   bounded output queue written only into an idle transmitter, so `poll` never blocks.
+//!   bounded output queue written only into an idle transmitter (or, for a reply passed on as
+//!   it arrives, at most [`host_link::HOST_WRITE_CHUNK`] bytes since it was last idle), so
+//!   `poll` never blocks.
 //! * Every link is heard through `protocol_core`'s timed
 //!   [`Listener`](protocol_core::listener::Listener): each host link for its frames, the bus
 //!   (one listener for framed and transparent mode) for the Atom's replies, raw bytes, the
@@ -86,11 +93,13 @@
 //! [`BytePort::read_byte`](protocol_core::BytePort::read_byte) / [`HostPorts::read_from`]
 //! until it returns `None` (at most [`BUS_READ_BUDGET`] bus and [`host_link::HOST_READ_BUDGET`]
 //! bytes per host link per poll), and writes only into an idle transmitter, at most 67 bytes
-//! to the bus and 64 to a host link at a time, so a write never waits on a 128-byte UART
-//! FIFO. Timing comes only from `now_us`.
+//! to the bus and 64 to a host link at a time (a reply passed on as it arrives: 64 since the
+//! link's transmitter was last idle), so a write never waits on a 128-byte UART FIFO. Timing
+//! comes only from `now_us`.
 //!
-//! Latency (bench `latency`, virtual time): the Basic adds one poll period to each direction
-//! on an idle wire, beyond the frame's own wire time. Several clients (bench `router`): no
+//! Latency (bench `latency`, virtual time): the Basic adds one poll period host -> bus on an
+//! idle wire, beyond the frame's own wire time; bus -> host its reply is on its way before it
+//! has ended on the bus (cut-through). Several clients (bench `router`): no
 //! reply crossed or lost, the bus shared round robin.
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]

@@ -90,6 +90,9 @@ pub(crate) struct Request {
     pub(crate) answer: Answer,
     /// When it arrived (or was made), in microseconds.
     pub(crate) queued_us: u64,
+    /// Its reply may be passed on to the client as it arrives on the bus (cut-through): a
+    /// client on a serial link, in pymycobot's dialect, getting the reply as it is.
+    pub(crate) cut_through: bool,
 }
 
 #[cfg(test)]

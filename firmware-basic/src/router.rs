@@ -315,6 +315,14 @@ impl Router {
         }
     }
 
+    /// True if a request for the Atom seems to be arriving on some link, soon to be in
+    /// ([`HostLink::request_coming`]); a link capturing a 0xB0 text is not sending a frame.
+    pub(crate) fn request_coming(&self, now_us: u64) -> bool {
+        self.slots
+            .iter()
+            .any(|s| s.open && s.capture.is_none() && s.link.request_coming(now_us))
+    }
+
     /// True if any link has a request waiting.
     pub(crate) fn has_requests(&self) -> bool {
         self.slots.iter().any(|s| s.open && !s.waiting.is_empty())
@@ -346,9 +354,14 @@ impl Router {
                 continue;
             }
             let client = Client::new(link, slot.session);
+            // A serial client reading pymycobot's frames gets its reply as it arrives, when it
+            // gets it as it is.
+            let serial =
+                slot.link.kind() == LinkKind::Serial && slot.link.dialect() == Dialect::Pymycobot;
             let request = |waiting: Waiting| Request {
                 frame: waiting.frame,
                 origin: Origin::Host(client),
+                cut_through: serial && waiting.answer == Answer::AsIs,
                 answer: waiting.answer,
                 queued_us: waiting.arrived_us,
             };
@@ -381,12 +394,38 @@ impl Router {
         }
     }
 
-    /// Queues `reply` for `client`, whole or not at all.
+    /// Queues `reply` for `client`, whole or not at all; a reply being passed on as it
+    /// arrived ([`Self::stream_open`]) is completed with it instead, if it is that reply.
     pub(crate) fn send_reply(&mut self, client: Client, reply: &Frame) -> Delivery {
-        match self.link_of(client).map(|link| link.send_frame(reply)) {
+        match self
+            .link_of(client)
+            .map(|link| link.stream_finish(reply) || link.send_frame(reply))
+        {
             None => Delivery::Gone,
             Some(true) => Delivery::Queued,
             Some(false) => Delivery::NoRoom,
+        }
+    }
+
+    /// Starts passing `client`'s reply on as it arrives: its first bytes `head`, its whole
+    /// length `len` reserved ([`HostLink::stream_open`]). False if that cannot be (the client
+    /// has gone, no room, not a serial link): the reply then goes whole when it is complete.
+    pub(crate) fn stream_open(&mut self, client: Client, head: &[u8], len: usize) -> bool {
+        self.link_of(client)
+            .is_some_and(|link| link.stream_open(head, len))
+    }
+
+    /// The next bytes of `client`'s reply being passed on ([`HostLink::stream_more`]).
+    pub(crate) fn stream_more(&mut self, client: Client, bytes: &[u8]) {
+        if let Some(link) = self.link_of(client) {
+            link.stream_more(bytes);
+        }
+    }
+
+    /// `client`'s reply being passed on will not complete ([`HostLink::stream_cut`]).
+    pub(crate) fn stream_cut(&mut self, client: Client) {
+        if let Some(link) = self.link_of(client) {
+            link.stream_cut();
         }
     }
 

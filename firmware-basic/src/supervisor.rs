@@ -144,6 +144,7 @@ impl Supervisor {
             origin,
             answer: protocol_core::dialect::Answer::AsIs,
             queued_us: now_us,
+            cut_through: false,
         })
     }
 
@@ -242,7 +243,11 @@ impl Supervisor {
             Event::Collision => {
                 self.status.collisions = self.status.collisions.wrapping_add(1);
             }
-            Event::Unsolicited => {}
+            // A reply passed on as it arrives: its end (the reply, or the timeout) counts.
+            Event::Unsolicited
+            | Event::ReplyHead { .. }
+            | Event::ReplyMore { .. }
+            | Event::ReplyCut { .. } => {}
         }
     }
 
@@ -298,6 +303,7 @@ mod tests {
             origin,
             answer: protocol_core::dialect::Answer::AsIs,
             queued_us: 0,
+            cut_through: false,
         }
     }
 

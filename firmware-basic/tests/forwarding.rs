@@ -3,9 +3,12 @@
 
 mod common;
 
-use common::{BUS_BYTE_NS, Rig, frame};
+use common::{BUS_BYTE_NS, Rig, frame, pymycobot_reads};
+use firmware_basic::forwarder::HOLD_BYTE;
+use firmware_basic::host_link::STREAM_FILLER;
 use firmware_basic::{AtomLink, BasicConfig, BasicError, EchoMode};
 use protocol_core::Frame;
+use protocol_core::timing::BUS_QUIET_BEFORE_SEND_US;
 
 const GET_ANGLES: u8 = 0x20;
 const IS_POWERED_ON: u8 = 0x12;
@@ -496,12 +499,28 @@ fn a_garbled_reply_is_lost_and_the_request_never_sent_again() {
             rig.run_us(BasicConfig::default().reply_timeout_us + 10_000);
             let context = format!("byte {garbled}, echo {echo}");
             assert_eq!(rig.atom_got.len(), 1, "{context}");
-            assert!(rig.host.received().is_empty(), "{context}");
+            // With only the footer hit, the reply's start was passed on as it arrived
+            // (cut-through), and the rest of its place filled: no frame for any client.
+            let passed_on = if garbled == 5 {
+                vec![0xFE, 0xFE, 0x03, IS_POWERED_ON, 0x01, STREAM_FILLER]
+            } else {
+                Vec::new()
+            };
+            assert_eq!(rig.host.received(), passed_on, "{context}");
+            assert!(rig.host_frames().is_empty(), "{context}");
+            assert!(
+                pymycobot_reads(&rig.host.received()).is_empty(),
+                "{context}"
+            );
             // The client's resend is answered.
             rig.host.send(&frame(IS_POWERED_ON, &[]));
             rig.run_us(5_000);
             assert_eq!(rig.atom_got.len(), 2, "{context}");
-            assert_eq!(rig.host.received(), frame(IS_POWERED_ON, &[1]), "{context}");
+            let answer = frame(IS_POWERED_ON, &[1]);
+            assert!(rig.host.received().ends_with(&answer), "{context}");
+            let frames = rig.host_frames();
+            assert_eq!(frames.len(), 1, "{context}: {frames:?}");
+            assert_eq!(pymycobot_reads(&rig.host.received()), [answer], "{context}");
         }
     }
 }
@@ -624,4 +643,221 @@ fn a_request_in_the_atoms_gap_is_answered_while_it_polls_servos() {
             }
         }
     }
+}
+
+/// When the Atom's reply to the last request ended on the bus, ns.
+fn atom_reply_end_ns(rig: &Rig) -> u64 {
+    let (start, bytes) = rig.atom_sent.last().unwrap();
+    start + bytes.len() as u64 * BUS_BYTE_NS
+}
+
+#[test]
+fn a_reply_reaches_a_serial_client_before_it_has_ended_on_the_bus_and_without_a_gap() {
+    for echo in [true, false] {
+        let mut rig = Rig::quiet(echo);
+        rig.host.send(&frame(GET_ANGLES, &[]));
+        rig.run_us(5_000);
+        let reply = angles_reply();
+        assert_eq!(rig.host.received(), reply, "echo {echo}");
+        let starts: Vec<u64> = rig.host.from_basic.iter().map(|&(t, _)| t).collect();
+        let (bus_start, _) = rig.atom_sent[0];
+        // Its CMD (the fourth byte) is in at the start plus 4 byte times, and the poll after.
+        assert!(
+            starts[0] <= bus_start + 4 * BUS_BYTE_NS + rig.step_ns,
+            "echo {echo}: USB from {} ns, the reply on the bus from {bus_start} ns",
+            starts[0]
+        );
+        assert!(starts[0] < atom_reply_end_ns(&rig));
+        assert!(
+            starts
+                .windows(2)
+                .all(|w| w[1] - w[0] == common::HOST_BYTE_NS),
+            "echo {echo}: back to back on the wire: {starts:?}"
+        );
+    }
+}
+
+#[test]
+fn without_cut_through_a_reply_goes_once_it_has_ended_on_the_bus() {
+    let mut rig = Rig::new(
+        BasicConfig {
+            power_on_at_boot: false,
+            probe_interval_us: 0,
+            cut_through: false,
+            ..BasicConfig::default()
+        },
+        true,
+    );
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(5_000);
+    assert_eq!(rig.host.received(), angles_reply());
+    assert!(rig.host.from_basic[0].0 >= atom_reply_end_ns(&rig));
+}
+
+#[test]
+fn a_network_client_and_a_seed_client_get_each_reply_whole() {
+    let mut rig = Rig::quiet(true);
+    let net = rig.connect().unwrap();
+    rig.client(net).send(&frame(GET_ANGLES, &[]));
+    rig.run_us(5_000);
+    let client = rig.client(net);
+    assert_eq!(client.received(), angles_reply());
+    let first = client.from_basic[0].0;
+    assert!(
+        client.from_basic.iter().all(|&(t, _)| t == first),
+        "in one write: pymycobot's socket client takes one recv for the whole reply"
+    );
+    assert!(first >= atom_reply_end_ns(&rig));
+    // The seed dialect: its clients read frames of their own; replies go whole.
+    rig.host.send(&frame(0xC5, &[2]));
+    rig.run_us(2_000);
+    rig.host.from_basic.clear();
+    rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(5_000);
+    assert_eq!(rig.host.received(), angles_reply());
+    assert!(rig.host.from_basic[0].0 >= atom_reply_end_ns(&rig));
+}
+
+#[test]
+fn a_reply_cut_by_noise_leaves_no_frame_and_the_atoms_resend_gets_through() {
+    let reply = angles_reply();
+    // Noise hits the reply from its byte `hit` to its footer: the Basic had begun to pass it on
+    // (its CMD was in), and the frame does not end in FA. The Atom's echo shows it the
+    // collision and it sends the reply again (firmware-atom's schedule; here another station
+    // sends the same bytes once the wire has been quiet).
+    for hit in [5usize, 11, 16] {
+        for cut_through in [true, false] {
+            let mut rig = Rig::new(
+                BasicConfig {
+                    power_on_at_boot: false,
+                    probe_interval_us: 0,
+                    cut_through,
+                    ..BasicConfig::default()
+                },
+                true,
+            );
+            rig.host.send(&frame(GET_ANGLES, &[]));
+            // The scripted Atom keeps clear of traffic it knows is coming: the noise is
+            // scheduled once its reply is on the wire.
+            while rig.atom_sent.is_empty() {
+                rig.step();
+            }
+            let reply_start_ns = rig.atom_sent[0].0;
+            let noise = vec![0x00; reply.len() - hit];
+            rig.wire()
+                .inject(reply_start_ns + hit as u64 * BUS_BYTE_NS, &noise);
+            let resend_ns = reply_start_ns + (reply.len() as u64 + 10) * BUS_BYTE_NS;
+            rig.wire().inject(resend_ns, &reply);
+            rig.run_us(10_000);
+            let context = format!("hit at {hit}, cut-through {cut_through}");
+            let received = rig.host.received();
+            assert_eq!(rig.host_frames().len(), 1, "{context}: {received:02x?}");
+            assert_eq!(
+                pymycobot_reads(&received),
+                std::slice::from_ref(&reply),
+                "{context}"
+            );
+            assert!(received.ends_with(&reply), "{context}");
+            if cut_through {
+                // The garbled reply's start, then filler up to its length: no frame.
+                assert_eq!(
+                    received.len(),
+                    2 * reply.len(),
+                    "{context}: {received:02x?}"
+                );
+                assert_eq!(received[..hit], reply[..hit], "{context}");
+            } else {
+                assert_eq!(received, reply, "{context}");
+            }
+            assert_eq!(rig.atom_got.len(), 1, "{context}: the request went once");
+        }
+    }
+}
+
+/// A rig whose scripted Atom polls a servo from 1 ms on, with the bus hold on or off.
+fn polling_rig(bus_hold: bool) -> Rig {
+    let mut rig = Rig::new(
+        BasicConfig {
+            power_on_at_boot: false,
+            probe_interval_us: 0,
+            bus_hold,
+            ..BasicConfig::default()
+        },
+        true,
+    );
+    rig.step_ns = 2_000;
+    rig.run_us(1_000);
+    let now = rig.now_ns;
+    rig.wire().poll_servos(now, now + 1_000_000_000);
+    rig
+}
+
+/// How long after it was in (its last byte from the host) the request went onto the bus, us,
+/// when the host starts sending it `phase_ns` after the Atom started polling.
+fn request_wait_us(bus_hold: bool, phase_ns: u64) -> u64 {
+    let mut rig = polling_rig(bus_hold);
+    rig.run_us(phase_ns / 1_000);
+    let in_ns = rig.host.send(&frame(GET_ANGLES, &[]));
+    rig.run_us(3_000);
+    assert_eq!(
+        rig.host.received(),
+        angles_reply(),
+        "hold {bus_hold}, phase {phase_ns}"
+    );
+    assert_eq!(rig.atom_got.len(), 1);
+    assert_eq!(rig.wire().collisions(), 0);
+    let sent = rig.wire().basic_sent.clone();
+    let frame_start = sent
+        .windows(2)
+        .find(|w| w[0].1 == 0xFE && w[1].1 == 0xFE)
+        .map(|w| w[0].0)
+        .unwrap();
+    let held = sent
+        .iter()
+        .filter(|&&(t, b)| t < frame_start && b == HOLD_BYTE)
+        .count();
+    assert!(bus_hold || held == 0);
+    (frame_start - in_ns) / 1_000
+}
+
+#[test]
+fn while_the_atom_polls_a_request_goes_soon_after_it_is_in_if_the_bus_was_held_for_it() {
+    let phases: Vec<u64> = (0..40).map(|k| k * 10_997).collect();
+    let held: Vec<u64> = phases.iter().map(|&p| request_wait_us(true, p)).collect();
+    let not_held: Vec<u64> = phases.iter().map(|&p| request_wait_us(false, p)).collect();
+    for ((phase, h), n) in phases.iter().zip(&held).zip(&not_held) {
+        // After its last hold byte the request waits for the quiet every start needs.
+        assert!(
+            *h <= n + BUS_QUIET_BEFORE_SEND_US,
+            "phase {phase} ns: {h} us held, {n} us not"
+        );
+    }
+    let mean = |w: &[u64]| w.iter().sum::<u64>() / w.len() as u64;
+    assert!(
+        mean(&held) * 3 < mean(&not_held),
+        "held {held:?}, not held {not_held:?}"
+    );
+}
+
+#[test]
+fn a_client_whose_frames_never_end_cannot_starve_the_servo_refresh() {
+    // Plausible headers back to back, each with a footer that is not FA: every one looks like a
+    // request coming until its last byte.
+    let junk: Vec<u8> = [0xFE, 0xFE, 0x03, GET_ANGLES, 0x01, 0x00].repeat(200);
+    let reads = |bus_hold: bool| {
+        let mut rig = polling_rig(bus_hold);
+        let from = rig.wire().servo_reads.len();
+        rig.host.send(&junk);
+        rig.run_us(100_000);
+        assert!(rig.atom_got.is_empty());
+        assert!(rig.host.received().is_empty());
+        rig.wire().servo_reads.len() - from
+    };
+    let (held, free) = (reads(true), reads(false));
+    // At least one servo transaction after each hold: here about one per junk header.
+    assert!(
+        held * 2 >= free,
+        "{held} servo reads with the hold, {free} without"
+    );
+    assert!(held >= 100_000 / 1_300, "{held}");
 }

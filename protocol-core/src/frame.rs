@@ -321,6 +321,13 @@ impl FrameDecoder {
         self.scanner.has_partial()
     }
 
+    /// The bytes held: the candidate in progress (from its first `FE`) and whatever arrived
+    /// after its start; empty when no frame is in progress. A transponder that passes a frame
+    /// on as it arrives reads it here.
+    pub fn partial(&self) -> &[u8] {
+        self.scanner.bytes()
+    }
+
     /// Number of received bytes that were not part of any frame (noise, servo packets,
     /// rejected candidates). Wraps at `u32::MAX`.
     pub fn skipped_bytes(&self) -> u32 {

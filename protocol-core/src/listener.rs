@@ -348,6 +348,20 @@ impl Listener {
         self.frames.has_partial() || !self.held.is_empty()
     }
 
+    /// The host frame candidate being heard: the stream position of its first byte (counting
+    /// every byte the frame decoder has taken) and its bytes so far (from its first `FE`);
+    /// empty bytes when none is in progress. The position tells one candidate from the next:
+    /// a candidate dropped (cut short, or not a frame) and another begun shows a new position.
+    pub fn frame_partial(&self) -> (u64, &[u8]) {
+        (self.frames_front(), self.frames.partial())
+    }
+
+    /// How many bytes the frame decoder has taken so far: the stream position the next byte
+    /// given out as [`Heard::Byte`] will have (each such byte is then taken by it, in order).
+    pub fn frames_heard(&self) -> u64 {
+        self.frames_fed
+    }
+
     /// True while part of the open transmission's echo has come back: the line echoes, even if
     /// [`EchoMode::Auto`] has not judged a whole echo yet.
     pub fn echo_coming_back(&self) -> bool {
@@ -602,6 +616,25 @@ mod tests {
 
     fn frame(cmd: u8, data: &[u8]) -> Frame {
         Frame::new(cmd, data).unwrap()
+    }
+
+    #[test]
+    fn the_frame_being_heard_is_seen_with_its_place_in_the_stream() {
+        let mut rx = Listener::new(ListenerConfig::new().with_packets(false).with_bytes(true));
+        assert_eq!(rx.frame_partial(), (0, &[][..]));
+        run(&mut rx, 0, &[0x11, 0xFE, 0xFE, 0x03]);
+        assert_eq!(rx.frames_heard(), 4);
+        assert_eq!(rx.frame_partial(), (1, &[0xFE, 0xFE, 0x03][..]));
+        // Its footer is wrong: dropped, and the rescan finds nothing in it.
+        run(&mut rx, 100, &[0x20, 0x01, 0x00]);
+        assert_eq!(rx.frame_partial().1, &[][..]);
+        // The next one is another candidate, at another place.
+        run(&mut rx, 200, &[0xFE, 0xFE]);
+        assert_eq!(rx.frame_partial(), (7, &[0xFE, 0xFE][..]));
+        // Cut short by a quiet line.
+        tick(&mut rx, 250 + BUS_FRAME_GAP_US);
+        assert_eq!(rx.frame_partial().1, &[][..]);
+        assert_eq!(rx.frames_heard(), 9);
     }
 
     fn heard_frames(heard: &[Heard]) -> std::vec::Vec<Frame> {

@@ -142,6 +142,11 @@ impl<const N: usize> Scanner<N> {
         self.buf.len()
     }
 
+    /// The bytes held, the candidate in progress first.
+    pub(crate) fn bytes(&self) -> &[u8] {
+        &self.buf
+    }
+
     /// Forgets the first `n` bytes held (all of them if fewer); a candidate starting after them
     /// is scanned as usual.
     pub(crate) fn discard(&mut self, n: usize) {

@@ -18,4 +18,4 @@ pub mod wire;
 
 pub use chain::ServoChain;
 pub use servo::{Faults, PacketListener, ServoStats, SimServo};
-pub use wire::{Bus, BusByte, HeardByte, SerialLine, StationId};
+pub use wire::{Bus, BusByte, HeardByte, LineByte, SerialLine, StationId};

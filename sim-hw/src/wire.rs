@@ -77,6 +77,17 @@ pub struct BusByte {
     pub garbled: bool,
 }
 
+/// One byte as it travelled on a [`SerialLine`], for latency measurements.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LineByte {
+    /// The byte.
+    pub byte: u8,
+    /// When its start bit began, in ns.
+    pub start_ns: u64,
+    /// When its stop bit ended (when the receiving end has it), in ns.
+    pub end_ns: u64,
+}
+
 /// A byte as a listener received it (garbled if it collided), with its sender.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct HeardByte {
@@ -395,6 +406,8 @@ pub struct SerialLine {
     overruns: u64,
     /// While the receiving board stands still: only its UART's FIFO takes bytes.
     frozen: Option<Frozen>,
+    /// Every byte that crossed the line, while tracing is on.
+    trace: Option<Vec<LineByte>>,
 }
 
 impl SerialLine {
@@ -407,7 +420,19 @@ impl SerialLine {
             arrived: VecDeque::new(),
             overruns: 0,
             frozen: None,
+            trace: None,
         }
+    }
+
+    /// Starts (or stops) recording every byte that crosses the line
+    /// ([`SerialLine::take_trace`]); off by default.
+    pub fn set_tracing(&mut self, on: bool) {
+        self.trace = if on { Some(Vec::new()) } else { None };
+    }
+
+    /// Bytes that crossed the line since the last call (empty unless tracing is on), in order.
+    pub fn take_trace(&mut self) -> Vec<LineByte> {
+        self.trace.as_mut().map(std::mem::take).unwrap_or_default()
     }
 
     /// Queues `bytes` at `now_ns`; the first starts at once if the line is idle.
@@ -424,6 +449,13 @@ impl SerialLine {
             let Some(byte) = self.queued.pop_front() else {
                 break;
             };
+            if let Some(trace) = self.trace.as_mut() {
+                trace.push(LineByte {
+                    byte,
+                    start_ns: self.current_start_ns,
+                    end_ns: self.current_start_ns + self.byte_time_ns,
+                });
+            }
             self.current_start_ns += self.byte_time_ns;
             if self.arrived.len() < Frozen::cap_at(self.frozen, self.current_start_ns) {
                 self.arrived.push_back(byte);
@@ -666,6 +698,27 @@ mod tests {
         run(&mut bus, 0, 10_000 * (RX_BUFFER_BYTES as u64 + 3));
         assert_eq!(bus.port(b).unwrap().rx_pending(), RX_BUFFER_BYTES);
         assert_eq!(bus.overruns(b), 3);
+    }
+
+    #[test]
+    fn serial_line_trace_has_each_bytes_wire_time() {
+        let mut line = SerialLine::new(HOST_BAUD);
+        line.send(0, &[7]);
+        line.deliver(1_000_000);
+        assert!(line.take_trace().is_empty(), "off by default");
+        line.set_tracing(true);
+        line.send(1_000_000, &[1, 2]);
+        line.deliver(2_000_000);
+        let trace = line.take_trace();
+        let times: Vec<(u8, u64, u64)> = trace
+            .iter()
+            .map(|b| (b.byte, b.start_ns, b.end_ns))
+            .collect();
+        assert_eq!(
+            times,
+            [(1, 1_000_000, 1_086_806), (2, 1_086_806, 1_173_612)]
+        );
+        assert!(line.take_trace().is_empty(), "taken");
     }
 
     #[test]

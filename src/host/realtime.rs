@@ -8,10 +8,11 @@
 //! beyond its limit: their connection is closed at once). With
 //! [`RealtimeDriver::follow_server_port`] the TCP server moves to the port the Basic's Wi-Fi
 //! settings name, as the board's sockets do. While clients are talking the tick
-//! is [`ACTIVE_TICK`], so a reply leaves at most that long after the simulated 115200 baud
-//! wire finished sending it (the wire itself takes 87 us per byte, 1.5 ms for a `get_angles`
-//! reply); when the line has been quiet for [`ACTIVE_SPELL`] the loop ticks at [`IDLE_TICK`]
-//! and costs almost no CPU.
+//! is [`ACTIVE_TICK`], and while a reply is on the simulated 115200 baud wire the loop wakes
+//! when each of its bytes arrives ([`RealtimeRobot::next_output_us`], with a timer slack of
+//! [`TIMER_SLACK_NS`]), so a reply byte reaches the client as soon as the wire has carried it
+//! (the wire itself takes 87 us per byte, 1.5 ms for a `get_angles` reply); when the line has
+//! been quiet for [`ACTIVE_SPELL`] the loop ticks at [`IDLE_TICK`] and costs almost no CPU.
 
 use std::io;
 use std::net::{IpAddr, SocketAddr};
@@ -35,6 +36,10 @@ use super::tcp::TcpServer;
 
 /// The longest the loop sleeps between two advances of virtual time while clients talk.
 pub const ACTIVE_TICK: Duration = Duration::from_micros(50);
+
+/// The timer slack of the loop's thread: how late the kernel may end its sleeps, in ns (its
+/// default is 50 us, which would hold back every reply byte by up to that much).
+pub const TIMER_SLACK_NS: std::ffi::c_ulong = 1_000;
 
 /// The longest the loop sleeps when the line is quiet (input still wakes it at once).
 pub const IDLE_TICK: Duration = Duration::from_millis(5);
@@ -127,6 +132,12 @@ pub trait RealtimeRobot {
     fn busy(&self) -> bool {
         false
     }
+    /// When (virtual time, us) the next byte on its way to the serial client arrives, if one is
+    /// on the wire: the loop wakes then to pass it on, instead of a tick later. The default:
+    /// never known.
+    fn next_output_us(&self) -> Option<u64> {
+        None
+    }
 }
 
 /// The virtual robot served on one of its USB ports.
@@ -167,6 +178,11 @@ impl RealtimeRobot for ServedRobot {
     }
     fn server_port(&self) -> Option<u16> {
         Some(self.robot.basic()?.wifi()?.settings().port())
+    }
+    fn next_output_us(&self) -> Option<u64> {
+        self.robot
+            .link_next_arrival_ns(self.link)
+            .map(|ns| ns.div_ceil(1_000))
     }
 }
 
@@ -310,11 +326,23 @@ impl<R: RealtimeRobot> RealtimeDriver<R> {
         let mut next_report = Instant::now();
         let mut input = [0u8; 4096];
         let mut output = Vec::with_capacity(256);
+        // Sleeps end when asked, not up to the kernel's default 50 us later: a reply byte is
+        // passed on when it arrives (Linux; elsewhere the kernel's own slack applies).
+        #[cfg(any(target_os = "linux", target_os = "android"))]
+        let _ = nix::sys::prctl::set_timerslack(TIMER_SLACK_NS);
         while !stop.load(Ordering::Relaxed) {
             let active =
                 self.robot.busy() || last_traffic.is_some_and(|t| t.elapsed() < ACTIVE_SPELL);
             let line_full = self.pacer.room(self.robot.now_us().saturating_mul(1_000)) == 0;
-            self.wait_for_input(if active { ACTIVE_TICK } else { IDLE_TICK }, !line_full)?;
+            let mut tick = if active { ACTIVE_TICK } else { IDLE_TICK };
+            if let Some(arrival_us) = self.robot.next_output_us() {
+                // Wake when the next reply byte arrives (virtual time runs with the wall clock
+                // from the last sync).
+                let due =
+                    wall_sync + Duration::from_micros(arrival_us.saturating_sub(virtual_at_sync));
+                tick = tick.min(due.saturating_duration_since(Instant::now()));
+            }
+            self.wait_for_input(tick, !line_full)?;
 
             let mut target_us = virtual_at_sync.saturating_add(micros(wall_sync.elapsed()));
             let furthest_us = self.robot.now_us() + micros(MAX_CATCH_UP);

@@ -10,6 +10,7 @@
 //!   `--lost-replies ID:PER_MILLE`).
 //! * [`busy_client`]: a client that sends request after request and counts late and lost
 //!   answers.
+//! * [`hops`]: where the time of a host round trip through the Basic goes, hop by hop.
 //! * [`external`]: the same bus and servos serving boards that run elsewhere (the real images on
 //!   an emulated chip), whole frames in and the bus's bytes, echo included, out.
 //! * [`VirtualRobot`]: the real `firmware_basic::Basic` and `firmware_atom::Atom` wired to seven
@@ -51,6 +52,7 @@ pub mod busy_client;
 pub mod contact;
 pub mod external;
 pub mod flash_timing;
+pub mod hops;
 pub mod measure;
 pub mod reply_faults;
 mod robot;
@@ -65,4 +67,4 @@ pub use robot::{
     SERVO_IDS, SimBasicIo, VirtualRobot,
 };
 pub use servo::{Faults, PacketListener, ServoStats, SimServo};
-pub use wire::{Bus, BusByte, HeardByte, SerialLine, StationId};
+pub use wire::{Bus, BusByte, HeardByte, LineByte, SerialLine, StationId};

@@ -15,6 +15,7 @@ use protocol_core::{Frame, FrameDecoder};
 use super::basic_flash::BasicFlashStore;
 use super::contact::{self, Obstacle};
 use super::flash_timing::{FlashTiming, FlashWork};
+use super::hops::{BasicMark, HopTrace};
 use super::reply_faults::ReplyFault;
 use super::servo::SimServo;
 use super::wire::{Bus, HeardByte, SerialLine, SerialPort, StationId};
@@ -398,6 +399,17 @@ pub struct VirtualRobot {
     collisions: Vec<(u64, Collision)>,
     /// How long a board stands still for its flash.
     flash_timing: FlashTiming,
+    /// The Basic's marks while hop tracing is on ([`VirtualRobot::set_hop_tracing`]).
+    basic_marks: Option<BasicMarks>,
+}
+
+/// The Basic's marks so far, and its counts of host frames and forwarded replies after its
+/// last poll (a mark is a count that grew).
+#[derive(Debug, Default)]
+struct BasicMarks {
+    marks: Vec<(u64, BasicMark)>,
+    host_frames: u32,
+    replies: u32,
 }
 
 impl VirtualRobot {
@@ -441,7 +453,61 @@ impl VirtualRobot {
             next_poll_ns: 0,
             collisions: Vec::new(),
             flash_timing: config.flash_timing,
+            basic_marks: None,
         }
+    }
+
+    /// Starts (or stops) tracing every byte on the bus and on the Basic's USB serial, both
+    /// ways, and the polls in which the Basic took a host frame or forwarded a reply: what
+    /// [`HopTrace::round_trips`] cuts into hops. Off by default.
+    pub fn set_hop_tracing(&mut self, on: bool) {
+        self.bus.set_tracing(on);
+        if let Some(basic) = self.basic.as_mut() {
+            basic.usb.to_board.set_tracing(on);
+            basic.usb.to_host.set_tracing(on);
+        }
+        self.basic_marks = on.then(|| {
+            let status = self.basic().map(Basic::status).unwrap_or_default();
+            BasicMarks {
+                marks: Vec::new(),
+                host_frames: status.host_frames,
+                replies: status.replies_forwarded,
+            }
+        });
+    }
+
+    /// What was traced since hop tracing began or the last call ([`VirtualRobot::set_hop_tracing`]).
+    pub fn take_hop_trace(&mut self) -> HopTrace {
+        let (to_basic, to_host) = self
+            .basic
+            .as_mut()
+            .map(|b| (b.usb.to_board.take_trace(), b.usb.to_host.take_trace()))
+            .unwrap_or_default();
+        HopTrace {
+            bus: self.bus.take_trace(),
+            to_basic,
+            to_host,
+            basic_marks: self
+                .basic_marks
+                .as_mut()
+                .map(|m| std::mem::take(&mut m.marks))
+                .unwrap_or_default(),
+        }
+    }
+
+    /// Notes what the Basic's poll at `now_ns` did, while hop tracing is on.
+    fn mark_basic(&mut self, now_ns: u64) {
+        let (Some(m), Some(basic)) = (self.basic_marks.as_mut(), self.basic.as_ref()) else {
+            return;
+        };
+        let status = basic.firmware.basic().status();
+        if status.host_frames != m.host_frames {
+            m.marks.push((now_ns, BasicMark::HostFrame));
+        }
+        if status.replies_forwarded != m.replies {
+            m.marks.push((now_ns, BasicMark::ReplyForwarded));
+        }
+        (m.host_frames, m.replies) = (status.host_frames, status.replies_forwarded);
     }
 
     /// This robot with its Basic's flash (its Wi-Fi settings) in `flash`, e.g. kept in a file
@@ -524,6 +590,17 @@ impl VirtualRobot {
                 out.extend_from_slice(bytes);
             }
         }
+    }
+
+    /// When (virtual ns) the next byte on its way to the host on `link` arrives, if one is on
+    /// the wire: a serial link's; a network client's bytes arrive at once, so never.
+    pub fn link_next_arrival_ns(&self, link: HostLink) -> Option<u64> {
+        let usb = match link {
+            HostLink::Basic => &self.basic.as_ref()?.usb,
+            HostLink::AtomUsb => &self.atom_usb,
+            HostLink::Network(_) => return None,
+        };
+        usb.to_host.next_event_ns()
     }
 
     /// Takes the next byte that arrived at the host on `link`.
@@ -617,7 +694,12 @@ impl VirtualRobot {
 
     /// Runs the robot until virtual time `t_us` (no-op if that is not in the future).
     pub fn run_until(&mut self, t_us: u64) {
-        let target = t_us.saturating_mul(1_000);
+        self.run_until_ns(t_us.saturating_mul(1_000));
+    }
+
+    /// Runs the robot until virtual time `target` in nanoseconds (no-op if that is not in the
+    /// future).
+    pub fn run_until_ns(&mut self, target: u64) {
         while self.now_ns < target {
             let next = self.next_event_ns(target).max(self.now_ns + 1);
             self.step(next);
@@ -683,6 +765,7 @@ impl VirtualRobot {
             let until = now_ns + flash_busy_us(before, after, self.flash_timing) * 1_000;
             let board = (&mut basic.main_loop, basic.station, &mut basic.usb);
             stand_still_until(board, &mut self.bus, now_ns, until);
+            self.mark_basic(now_ns);
         }
         if self.atom_loop.runs_at(now_ns)
             && let Some(mut bus) = self.bus.port(self.atom_station)
@@ -982,6 +1065,29 @@ mod tests {
         let mut frames = Vec::new();
         FrameDecoder::new().feed(&rest, |f| frames.push(f));
         assert_eq!(frames.len(), 1, "the second reply is intact: {rest:02x?}");
+    }
+
+    #[test]
+    fn the_next_byte_to_the_host_is_known_while_it_is_on_the_wire() {
+        let mut robot = VirtualRobot::new(RobotConfig::default());
+        robot.run_for(10_000);
+        assert_eq!(robot.link_next_arrival_ns(HostLink::Basic), None);
+        robot.host_write(&Request::GetBasicVersion.to_frame().to_bytes());
+        let byte_ns = protocol_core::timing::wire_time_ns(1, HOST_BAUD);
+        let mut arrivals = Vec::new();
+        for _ in 0..2_000 {
+            if let Some(t) = robot.link_next_arrival_ns(HostLink::Basic)
+                && arrivals.last() != Some(&t)
+            {
+                arrivals.push(t);
+            }
+            robot.run_for(10);
+        }
+        // The Basic's answer, `FE FE 03 C1 0A FA`: six bytes, one byte time apart.
+        assert_eq!(arrivals.len(), 6, "{arrivals:?}");
+        assert!(arrivals.windows(2).all(|w| w[1] - w[0] == byte_ns));
+        let net = robot.connect().expect("a network client");
+        assert_eq!(robot.link_next_arrival_ns(net), None, "no wire time");
     }
 
     #[test]

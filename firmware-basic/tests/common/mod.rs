@@ -698,3 +698,48 @@ impl Rig {
 pub fn frame(cmd: u8, data: &[u8]) -> Vec<u8> {
     Frame::new(cmd, data).unwrap().to_bytes().to_vec()
 }
+
+/// The frames pymycobot 4.0.7's serial client (`pymycobot.common.read`) would return from
+/// `bytes`, one per call, as it parses them: it waits for `FE FE` (two in a row), takes the
+/// next byte as LEN (one above 30 is skipped and the byte after it read as LEN), reads LEN
+/// bytes and returns the frame if the last one is `FA`; otherwise it goes on waiting for the
+/// next `FE FE`, and a call that runs out of bytes returns nothing (its timeout).
+pub fn pymycobot_reads(bytes: &[u8]) -> Vec<Vec<u8>> {
+    let mut out = Vec::new();
+    let mut rest = bytes.iter().copied();
+    'calls: loop {
+        let mut datas: Vec<u8> = Vec::new();
+        let mut data_len: i32 = -1;
+        let (mut k, mut pre) = (0usize, 0usize);
+        for data in rest.by_ref() {
+            k += 1;
+            if data_len == 1 && data == 0xFA {
+                datas.push(data);
+                out.push(datas);
+                continue 'calls;
+            } else if datas.len() == 2 {
+                let len = i32::from(data as i8);
+                if !(0..=30).contains(&len) {
+                    data_len = -1;
+                    continue;
+                }
+                datas.push(data);
+                data_len = len;
+            } else if datas.len() > 2 && data_len > 0 {
+                datas.push(data);
+                data_len -= 1;
+            } else if data == 0xFE {
+                if datas.is_empty() {
+                    datas.push(data);
+                    pre = k;
+                } else if k - 1 == pre {
+                    datas.push(data);
+                } else {
+                    datas = vec![0xFE];
+                    pre = k;
+                }
+            }
+        }
+        return out;
+    }
+}
