@@ -819,23 +819,33 @@ mod tests {
 
     impl Waiting {
         fn new(cmd: u8, cut_through: bool) -> Self {
-            let config = BasicConfig {
-                echo: EchoMode::Absent,
-                ..BasicConfig::default()
-            };
-            let mut waiting = Self {
-                forwarder: Forwarder::new(),
-                listener: bus_listener(EchoMode::Absent),
-                config,
-                now_us: 1_000,
-                events: std::vec::Vec::new(),
-            };
+            let mut waiting = Self::on_line(EchoMode::Absent);
             waiting.ask(cmd, cut_through);
             waiting
         }
 
+        /// A forwarder with nothing in flight on a line with `echo`.
+        fn on_line(echo: EchoMode) -> Self {
+            Self {
+                forwarder: Forwarder::new(),
+                listener: bus_listener(echo),
+                config: BasicConfig {
+                    echo,
+                    ..BasicConfig::default()
+                },
+                now_us: 1_000,
+                events: std::vec::Vec::new(),
+            }
+        }
+
         /// Sends a client's request `cmd` on a quiet wire and lets its transmission end.
         fn ask(&mut self, cmd: u8, cut_through: bool) {
+            self.send(cmd, cut_through);
+            self.idle(100);
+        }
+
+        /// Sends a client's request `cmd` on a quiet wire, and polls no more.
+        fn send(&mut self, cmd: u8, cut_through: bool) {
             let client = crate::request::Client::new(crate::request::LinkId::USB, 0);
             self.forwarder.start(Request {
                 frame: Frame::new(cmd, &[]).unwrap(),
@@ -849,7 +859,6 @@ mod tests {
             self.forwarder
                 .try_send(self.now_us, &mut port, &mut self.listener);
             assert_eq!(port.0.len(), 5, "sent");
-            self.idle(100);
         }
 
         /// Bytes from the Atom, one per byte time at 1 Mbaud.
@@ -942,6 +951,21 @@ mod tests {
         );
         assert_eq!(end, Some(true));
         assert_eq!(w.replies().len(), 1);
+    }
+
+    #[test]
+    fn a_reply_that_repeats_the_request_is_passed_on_after_a_stall() {
+        // The emulated C3 Basic: its loop stood still from its request to the Atom's answer,
+        // byte for byte the request (as `01` to a backup of servo 1 is), on a line that does
+        // not echo; the answer was dropped as the request's echo and the client got nothing.
+        let mut w = Waiting::on_line(EchoMode::Auto);
+        w.listener.on_transmit(w.now_us, &[HOLD_BYTE]);
+        w.idle(1_000);
+        assert_eq!(w.listener.echo_heard(), Some(false), "learnt: no echo");
+        w.send(cmd::GET_ANGLES, false);
+        w.now_us += 3_000;
+        w.hear(&Frame::new(cmd::GET_ANGLES, &[]).unwrap().to_bytes());
+        assert_eq!(w.replies(), [Frame::new(cmd::GET_ANGLES, &[]).unwrap()]);
     }
 
     #[test]

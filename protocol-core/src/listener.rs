@@ -21,6 +21,8 @@
 //!   not echo and they were another station's, or a collision changed them). Each
 //!   transmission gets one [`Echo`] verdict, which is what the Basic decides retransmissions
 //!   on, and a collision on a line known to echo is also kept for [`Listener::take_collision`].
+//!   On a line that does not echo, a byte read after the window is over closes it first: an
+//!   answer that repeats the transmission byte for byte, read late, is the answer.
 //!
 //! * **Where a byte belongs.** The listener counts the bytes it decodes, so it knows where every
 //!   frame, packet and candidate lies in the stream. A host frame that completes inside a
@@ -274,6 +276,11 @@ impl Listener {
     pub fn push(&mut self, now_us: u64, byte: u8, on_heard: &mut impl FnMut(Heard)) {
         self.release_uncovered(on_heard);
         self.last_activity_us = self.last_activity_us.max(now_us);
+        if self.window.is_some() && self.late_bytes_are_foreign() {
+            // Read after the window is over (the station polled late): not the echo, even
+            // if it repeats what was sent (FE FE 03 EA 01 FA answers a backup of servo 1).
+            self.judge_echo(now_us, on_heard);
+        }
         if self.window.is_some() {
             if self.config.echo != EchoMode::Absent && self.sent.get(self.echoed) == Some(&byte) {
                 self.echoed += 1;
@@ -411,6 +418,18 @@ impl Listener {
             EchoMode::Present => true,
             EchoMode::Absent => false,
             EchoMode::Auto => self.echo_heard == Some(true),
+        }
+    }
+
+    /// True if a byte read after the echo window is over cannot be the echo: the line does not
+    /// echo ([`EchoMode::Absent`], or [`EchoMode::Auto`] once a transmission came back
+    /// silent). Where it echoes, or is not known yet, such a byte may be an echo the station
+    /// read late, and is matched as one.
+    fn late_bytes_are_foreign(&self) -> bool {
+        match self.config.echo {
+            EchoMode::Absent => true,
+            EchoMode::Auto => self.echo_heard == Some(false),
+            EchoMode::Present => false,
         }
     }
 
@@ -766,6 +785,40 @@ mod tests {
             !rx.take_collision(),
             "nothing to collide with on a silent line"
         );
+    }
+
+    #[test]
+    fn an_answer_that_repeats_the_request_is_not_its_echo_when_read_late() {
+        // Seen on the emulated C3 Basic: its loop stood still from its request's end to the
+        // Atom's answer, identical to the request; with the window still open at the read, the
+        // answer was dropped as the echo and the client never got it.
+        let backup = frame(0xEA, &[1]).to_bytes();
+        for config in [
+            ListenerConfig::new(),
+            ListenerConfig::new().with_echo(EchoMode::Absent),
+        ] {
+            let mut rx = Listener::new(config);
+            // Auto has learnt that the line does not echo.
+            rx.on_transmit(0, &backup);
+            tick(&mut rx, 1_000);
+            rx.on_transmit(10_000, &backup);
+            let heard = run(&mut rx, 13_000, &backup);
+            assert_eq!(
+                heard,
+                [Heard::Echo(Echo::Silent), Heard::Frame(frame(0xEA, &[1]))]
+            );
+            assert!(!rx.take_collision());
+        }
+        // Where the line echoes, or is not known yet, the same late read is the echo.
+        for known_echo in [false, true] {
+            let mut rx = Listener::default();
+            if known_echo {
+                rx.on_transmit(0, &backup);
+                run(&mut rx, 10, &backup);
+            }
+            rx.on_transmit(10_000, &backup);
+            assert_eq!(run(&mut rx, 13_000, &backup), [Heard::Echo(Echo::Whole)]);
+        }
     }
 
     #[test]

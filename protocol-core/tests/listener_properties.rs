@@ -6,6 +6,8 @@
 //! * Frames and packets that follow a quiet gap are found, whatever noise came before them.
 //! * On a line that echoes, the station's own transmissions never come out (as bytes, frames or
 //!   packets), whatever they contain, while other stations' frames and packets all do.
+//! * On a line that does not echo, an answer read late (the station's loop stood still after
+//!   its transmission) is always heard, even when it repeats the transmission byte for byte.
 //!
 //! Default case counts keep `cargo test` fast; raise them with `PROPTEST_CASES`.
 
@@ -427,5 +429,46 @@ proptest! {
             .filter_map(|i| match i { Item::Packet(p) => Some(p.clone()), _ => None })
             .collect();
         prop_assert!(in_order(&out.packets, &want_packets), "{:?} in {:?}", want_packets, out.packets);
+    }
+
+    #[test]
+    fn an_answer_read_late_on_a_line_without_echo_is_always_heard(
+        rounds in prop::collection::vec(
+            (any_item(), prop_oneof![Just(None), any_item().prop_map(Some)], 0u64..5_000),
+            1..8,
+        ),
+        echo in prop_oneof![Just(EchoMode::Auto), Just(EchoMode::Absent)],
+    ) {
+        let mut rx = Listener::new(ListenerConfig::new().with_bytes(true).with_echo(echo));
+        let mut out = Out::default();
+        // Auto learns that the line is silent from a first transmission.
+        rx.on_transmit(0, &[0x55]);
+        rx.on_time(1_000, &mut |h| out.take(h));
+        let mut answers = Vec::new();
+        let mut t = 10_000;
+        for (sent, other, stall_us) in &rounds {
+            // The answer: the transmission itself (a reply that repeats its request), or another.
+            let answer = other.clone().unwrap_or_else(|| sent.clone());
+            let sent = sent.bytes();
+            rx.on_transmit(t, &sent);
+            // No poll from the transmission until the answer is read, after its echo window.
+            t += BYTE_US * sent.len() as u64 + ECHO_GRACE_US + stall_us;
+            for b in answer.bytes() {
+                rx.push(t, b, &mut |h| out.take(h));
+            }
+            t += 2 * BUS_FRAME_GAP_US;
+            rx.on_time(t, &mut |h| out.take(h));
+            answers.push(answer);
+        }
+        prop_assert_eq!(rx.echo_bytes(), 0);
+        prop_assert!(!rx.take_collision());
+        let all: Vec<u8> = answers.iter().flat_map(Item::bytes).collect();
+        prop_assert_eq!(&out.bytes, &all);
+        for answer in &answers {
+            match answer {
+                Item::Frame(f) => prop_assert!(out.frames.contains(f), "{:?} lost", f),
+                Item::Packet(p) => prop_assert!(out.packets.contains(p), "{:?} lost", p),
+            }
+        }
     }
 }
