@@ -12,6 +12,8 @@
 #[cfg(target_os = "none")]
 pub mod clock;
 pub mod deadline;
+#[cfg(target_os = "none")]
+pub mod pass_cost;
 // Raw writes to the unused stack (the module says why).
 #[cfg(all(target_os = "none", target_arch = "riscv32"))]
 #[allow(unsafe_code)]

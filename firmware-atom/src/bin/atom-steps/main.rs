@@ -24,6 +24,7 @@ compile_error!("the atom-steps binary builds only for a chip: `.ci/link-esp32 --
 
 mod servos;
 
+use board_support::pass_cost::{PassCost, cycles};
 use board_support::{board_log, now_us};
 use esp_hal::{clock::CpuClock, main};
 use firmware_atom::{Atom, AtomConfig, RecordingIo};
@@ -35,19 +36,6 @@ use protocol_core::{BytePort, Frame, FrameDecoder};
 use crate::servos::ServoBus;
 
 esp_bootloader_esp_idf::esp_app_desc!();
-
-/// The CPU's cycle counter (on the C3, which has none that is safe to read, microseconds at
-/// its 160 MHz).
-fn cycles() -> u32 {
-    #[cfg(feature = "esp32")]
-    {
-        esp_hal::xtensa_lx::timer::get_cycle_count()
-    }
-    #[cfg(not(feature = "esp32"))]
-    {
-        (now_us() as u32).wrapping_mul(160)
-    }
-}
 
 /// The host link as the Atom's UART0 sees it: frames queued for the Atom, its replies kept.
 struct HostLink {
@@ -73,30 +61,6 @@ impl BytePort for HostLink {
 
     fn tx_idle(&self) -> bool {
         true
-    }
-}
-
-/// A step's passes: the first (where a command is taken, planned and answered) and the longest
-/// of the others (the motion it started, the state refresh, flash writes).
-#[derive(Default)]
-struct PassCost {
-    passes: u32,
-    first: u32,
-    longest: u32,
-    longest_at: u32,
-    total: u64,
-}
-
-impl PassCost {
-    fn add(&mut self, spent: u32) {
-        self.passes += 1;
-        self.total += u64::from(spent);
-        if self.passes == 1 {
-            self.first = spent;
-        } else if spent > self.longest {
-            self.longest = spent;
-            self.longest_at = self.passes;
-        }
     }
 }
 
@@ -157,7 +121,7 @@ impl Bench {
             cost.first,
             cost.longest,
             cost.longest_at,
-            cost.total / u64::from(cost.passes.max(1)),
+            cost.mean(),
             reply.map(|f| f.data()).unwrap_or(&[]),
             self.atom.error_code()
         );
@@ -265,12 +229,7 @@ fn main() -> ! {
             speed: SpeedPercent::MAX,
         });
         let leg = bench.run(20_000, 20_000, |_| true);
-        stream.passes += leg.passes;
-        stream.total += leg.total;
-        if leg.longest > stream.longest {
-            stream.longest = leg.longest;
-            stream.longest_at = stream.passes - leg.passes + leg.longest_at;
-        }
+        stream.extend(&leg);
     }
     bench.print("stream", &stream);
     let rest = bench.run(50_000, 5_000_000, |b| !b.atom.is_moving());
