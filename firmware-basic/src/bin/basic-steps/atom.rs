@@ -30,7 +30,7 @@ pub struct AtomBus {
     rx: Deque<(u64, u8), RX_BYTES>,
     /// When the wire is free again.
     busy_until_us: u64,
-    /// When the Atom starts its next servo transaction (`u64::MAX` while it owes a reply).
+    /// When the Atom starts its next servo transaction.
     next_transaction_us: u64,
     next_servo: u8,
     requests: FrameDecoder,
@@ -117,9 +117,7 @@ impl BytePort for AtomBus {
         let start = self.now_us.max(self.busy_until_us);
         let end = start + wire_time_us(bytes.len() as u32, BUS_BAUD);
         self.busy_until_us = end;
-        if self.next_transaction_us != u64::MAX {
-            self.next_transaction_us = self.next_transaction_us.max(end + GAP_US);
-        }
+        self.next_transaction_us = self.next_transaction_us.max(end + GAP_US);
         for &b in bytes {
             let mut found = self.requests.push(b);
             while let Some(frame) = found {
