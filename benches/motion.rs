@@ -9,7 +9,9 @@
 //!   the residual after removing the lag (RMS and worst), and whether the stream's end is a
 //!   clean stop at its last target. Then 50 Hz streams as a busy host sends them: samples late
 //!   by up to 5, 10 or 20 ms, 10 % or 30 % of them dropped, and bursts (the samples held up by
-//!   a stall of 60, 100 or 200 ms sent back to back): lag, residual and worst error for each.
+//!   a stall of 60, 100 or 200 ms sent back to back), and samples taken late by up to 10 or
+//!   20 ms (carrying the sine at the time they were sent, as a client that samples when it gets
+//!   to send): lag, residual and worst error for each.
 //! * **Lines**: send_coords mode 1 and jog_coord at speed 50: the flange's largest distance from
 //!   the straight segment, and its largest turn from the orientation.
 //! * **Arcs**: move_c_coords (0x8C) from the present pose through two more at speed 50 and 100:
@@ -327,7 +329,8 @@ impl Dice {
 
 /// Irregular 50 Hz streams, as a busy host sends them: each sample carries the sine at the time
 /// it was due, but arrives late by up to the jitter, or never (dropped), or after a stall
-/// together with the samples held up behind it (a burst).
+/// together with the samples held up behind it (a burst); or the client samples late, and the
+/// sample carries the sine at the time it was sent.
 fn irregular_streams() {
     println!(
         "== irregular 50 Hz streams (the sine at each sample's due time; residual against that \
@@ -344,6 +347,20 @@ fn irregular_streams() {
             .collect();
         schedule.sort_by_key(|(at, _)| *at);
         cases.push((format!("jitter 0..{jitter_ms} ms late"), schedule));
+    }
+    for jitter_ms in [10u64, 20] {
+        // A client that samples when it gets to send (pymycobot in a loop, a ROS node on a busy
+        // PC): a late sample carries the sine at its late time, not at the time it was due.
+        let mut dice = Dice(0x94D0_49BB_1331_11EB ^ jitter_ms);
+        let mut schedule: Schedule = regular(PERIOD_US, DURATION_US)
+            .into_iter()
+            .map(|(at, _)| {
+                let sent = at + (dice.roll() * (jitter_ms * 1000) as f64) as u64;
+                (sent, sent as f64 / 1e6)
+            })
+            .collect();
+        schedule.sort_by_key(|(at, _)| *at);
+        cases.push((format!("sampled 0..{jitter_ms} ms late"), schedule));
     }
     for percent in [10u32, 30] {
         let mut dice = Dice(0xD1B5_4A32_D192_ED03 ^ u64::from(percent));
