@@ -395,6 +395,12 @@ mod tests {
     }
 
     proptest::proptest! {
+        // A failure is printed, never written to a file that would fail every later run.
+        #![proptest_config(proptest::prelude::ProptestConfig {
+            failure_persistence: None,
+            ..proptest::prelude::ProptestConfig::default()
+        })]
+
         /// Every magnitude of dividend and divisor, each a random value shifted right by a
         /// random amount.
         #[test]
