@@ -59,6 +59,15 @@ impl PassCost {
         self.total += other.total;
     }
 
+    /// The longest pass of all, first included: its cycles, and which pass it was.
+    pub fn worst(&self) -> (u32, u32) {
+        if self.first >= self.longest {
+            (self.first, 1)
+        } else {
+            (self.longest, self.longest_at)
+        }
+    }
+
     /// The mean pass, cycles.
     pub fn mean(&self) -> u64 {
         self.total / u64::from(self.passes.max(1))

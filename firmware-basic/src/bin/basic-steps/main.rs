@@ -163,16 +163,13 @@ impl Bench {
     }
 
     fn print(&self, name: &str, cost: &PassCost, replies: u32, asked: u32, forwarded: u32) {
+        let (longest, at) = cost.worst();
         board_log!(
             "step {}: passes {}, longest {} cycles (pass {}), mean {}, replies {} of {}, forwarded {}",
             name,
             cost.passes,
-            cost.longest.max(cost.first),
-            if cost.first >= cost.longest {
-                1
-            } else {
-                cost.longest_at
-            },
+            longest,
+            at,
             cost.mean(),
             replies,
             asked,
