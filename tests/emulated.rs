@@ -12,8 +12,9 @@
 //! `esp32-picsimlab` where the ESP32 emulator has it (PICSimLab's fork), else `esp32`
 //! (`ESP_QEMU_MACHINE_ESP32` overrides it); `esp32c3` for the C3.
 //!
-//! `atom_loop_passes_on_the_emulated_esp32`: the cost of the Atom's loop passes on the ESP32,
-//! in instructions, against their budgets (docs/boards.md, "Loop passes on the chip").
+//! `atom_loop_passes_on_the_emulated_esp32` and `basic_loop_passes_on_the_emulated_esp32`: the
+//! cost of the Atom's and the Basic's loop passes on the ESP32, in instructions, against their
+//! budgets (docs/boards.md, "Loop passes on the chip").
 #![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing)] // a test harness: a panic is a failed check
 
 use std::io::{BufRead, BufReader, Write};
