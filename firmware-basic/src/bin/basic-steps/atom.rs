@@ -8,11 +8,12 @@
 //! the refresh goes on after the reply. Every byte is readable once it has crossed the wire at
 //! 1 Mbaud. The wire does not echo (the Basic finds that out, as on the emulated boards).
 
-use heapless::Deque;
 use protocol_core::command::cmd;
 use protocol_core::servo::{Instruction, Packet};
-use protocol_core::timing::{ATOM_TRANSACTION_GAP_US, BUS_BAUD, wire_time_us};
+use protocol_core::timing::{ATOM_TRANSACTION_GAP_US, BUS_BAUD};
 use protocol_core::{BytePort, Frame, FrameDecoder};
+
+use crate::line::Line;
 
 /// The Atom's quiet time after each servo transaction.
 const GAP_US: u64 = ATOM_TRANSACTION_GAP_US;
@@ -26,10 +27,7 @@ const RX_BYTES: usize = 512;
 /// The wire with the Atom and its servos on it. See the [module doc](self).
 pub struct AtomBus {
     now_us: u64,
-    /// Bytes for the Basic, each with the time its last bit is in.
-    rx: Deque<(u64, u8), RX_BYTES>,
-    /// When the wire is free again.
-    busy_until_us: u64,
+    wire: Line<RX_BYTES>,
     /// When the Atom starts its next servo transaction.
     next_transaction_us: u64,
     next_servo: u8,
@@ -43,8 +41,7 @@ impl AtomBus {
     pub fn new() -> Self {
         Self {
             now_us: 0,
-            rx: Deque::new(),
-            busy_until_us: 0,
+            wire: Line::new(BUS_BAUD),
             next_transaction_us: 0,
             next_servo: 1,
             requests: FrameDecoder::new(),
@@ -55,7 +52,7 @@ impl AtomBus {
     /// Lets the wire run to `now_us`: the servo transactions due by then go out.
     pub fn run_to(&mut self, now_us: u64) {
         self.now_us = now_us;
-        while self.next_transaction_us <= now_us && self.rx.len() + 64 < RX_BYTES {
+        while self.next_transaction_us <= now_us && self.wire.room() > 64 {
             let start = self.next_transaction_us;
             let id = self.next_servo;
             self.next_servo = if id >= 7 { 1 } else { id + 1 };
@@ -65,25 +62,14 @@ impl AtomBus {
             }
             .to_packet(id);
             let Some(read) = read else { return };
-            let asked = self.send(start, &read.to_bytes());
+            let asked = self.wire.send(start, &read.to_bytes());
             let state = [0u8; 31];
             let Some(answer) = Packet::new(id, 0, &state) else {
                 return;
             };
-            let answered = self.send(asked + TURNAROUND_US, &answer.to_bytes());
+            let answered = self.wire.send(asked + TURNAROUND_US, &answer.to_bytes());
             self.next_transaction_us = answered + GAP_US;
         }
-    }
-
-    /// Puts `bytes` on the wire from `start_us` (or when it is free); when the last is in.
-    fn send(&mut self, start_us: u64, bytes: &[u8]) -> u64 {
-        let mut t = start_us.max(self.busy_until_us);
-        for &b in bytes {
-            t += wire_time_us(1, BUS_BAUD);
-            self.rx.push_back((t, b)).ok();
-        }
-        self.busy_until_us = t;
-        t
     }
 
     /// The Atom's reply to a forwarded frame.
@@ -103,27 +89,19 @@ impl AtomBus {
 
 impl BytePort for AtomBus {
     fn read_byte(&mut self) -> Option<u8> {
-        match self.rx.front() {
-            Some(&(due, b)) if due <= self.now_us => {
-                self.rx.pop_front();
-                Some(b)
-            }
-            _ => None,
-        }
+        self.wire.take(self.now_us)
     }
 
     fn write(&mut self, bytes: &[u8]) {
         // The Basic's bytes cross the wire (no echo); the Atom holds its refresh for them.
-        let start = self.now_us.max(self.busy_until_us);
-        let end = start + wire_time_us(bytes.len() as u32, BUS_BAUD);
-        self.busy_until_us = end;
+        let end = self.wire.occupy(self.now_us, bytes.len());
         self.next_transaction_us = self.next_transaction_us.max(end + GAP_US);
         for &b in bytes {
             let mut found = self.requests.push(b);
             while let Some(frame) = found {
                 self.forwarded += 1;
                 if let Some(reply) = Self::reply(&frame) {
-                    let done = self.send(end + REPLY_AFTER_US, &reply.to_bytes());
+                    let done = self.wire.send(end + REPLY_AFTER_US, &reply.to_bytes());
                     self.next_transaction_us = done + GAP_US;
                 }
                 found = self.requests.next_frame();
@@ -132,6 +110,6 @@ impl BytePort for AtomBus {
     }
 
     fn tx_idle(&self) -> bool {
-        self.now_us >= self.busy_until_us
+        self.wire.free(self.now_us)
     }
 }

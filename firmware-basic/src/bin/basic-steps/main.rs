@@ -25,6 +25,7 @@ compile_error!(
 );
 
 mod atom;
+mod line;
 #[allow(dead_code)]
 #[path = "../basic/radio_start.rs"]
 mod radio_start;
@@ -36,12 +37,12 @@ use board_support::pass_cost::{PassCost, cycles};
 use board_support::{board_log, now_us};
 use esp_hal::{clock::CpuClock, main};
 use firmware_basic::{Basic, BasicConfig, NullIo};
-use heapless::Deque;
 use protocol_core::command::cmd;
-use protocol_core::timing::{HOST_BAUD, wire_time_us};
+use protocol_core::timing::HOST_BAUD;
 use protocol_core::{BytePort, Frame, FrameDecoder};
 
 use crate::atom::AtomBus;
+use crate::line::Line;
 use crate::screen_text::BoardStatus;
 
 esp_bootloader_esp_idf::esp_app_desc!();
@@ -54,8 +55,7 @@ const REPLY_DEADLINE_US: u64 = 100_000;
 /// The USB link: bytes for the Basic at 115 200 baud, its replies counted.
 struct HostLink {
     now_us: u64,
-    /// Bytes for the Basic, each with the time its last bit is in.
-    to_basic: Deque<(u64, u8), 512>,
+    to_basic: Line<512>,
     decoder: FrameDecoder,
     replies: u32,
 }
@@ -63,24 +63,13 @@ struct HostLink {
 impl HostLink {
     /// Queues `bytes` as a client writes them: back to back from now (or after what is queued).
     fn send(&mut self, bytes: &[u8]) {
-        let mut t = self.to_basic.back().map_or(self.now_us, |&(t, _)| t);
-        t = t.max(self.now_us);
-        for &b in bytes {
-            t += wire_time_us(1, HOST_BAUD);
-            self.to_basic.push_back((t, b)).ok();
-        }
+        self.to_basic.send(self.now_us, bytes);
     }
 }
 
 impl BytePort for HostLink {
     fn read_byte(&mut self) -> Option<u8> {
-        match self.to_basic.front() {
-            Some(&(due, b)) if due <= self.now_us => {
-                self.to_basic.pop_front();
-                Some(b)
-            }
-            _ => None,
-        }
+        self.to_basic.take(self.now_us)
     }
 
     fn write(&mut self, bytes: &[u8]) {
@@ -194,7 +183,7 @@ fn main() -> ! {
         bus: AtomBus::new(),
         host: HostLink {
             now_us: 0,
-            to_basic: Deque::new(),
+            to_basic: Line::new(HOST_BAUD),
             decoder: FrameDecoder::new(),
             replies: 0,
         },
