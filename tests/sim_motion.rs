@@ -300,6 +300,91 @@ fn stream_joint1(robot: &mut VirtualRobot, start_us: u64, from: u64, to: u64) {
 }
 
 #[test]
+fn a_missing_stream_sample_is_bridged_along_the_stream_not_held() {
+    // Target 25 of a 50 Hz stream ramping joint 1 at 60 deg/s never comes. The joint goes on
+    // at the stream's speed through the hole (it heads for where the stream's motion puts the
+    // missing target) instead of braking past target 24 and then hurrying after target 26.
+    let mut robot = arm();
+    let start_us = robot.now_us();
+    stream_joint1(&mut robot, start_us, 0, 25);
+    let mut speeds = Vec::new();
+    let hole_us = start_us + 24 * 20_000;
+    let mut probe = |robot: &mut VirtualRobot, until_us: u64| {
+        let mut before = robot.shaft_angles_deg()[0];
+        while robot.now_us() < until_us {
+            robot.run_for(5_000);
+            let now = robot.shaft_angles_deg()[0];
+            if robot.now_us() > hole_us + 10_000 {
+                speeds.push((now - before) / 0.005);
+            }
+            before = now;
+        }
+    };
+    probe(&mut robot, start_us + 26 * 20_000);
+    stream_joint1(&mut robot, start_us, 26, 30);
+    probe(&mut robot, start_us + 32 * 20_000);
+    let slowest = speeds.iter().copied().fold(f64::MAX, f64::min);
+    let fastest = speeds.iter().copied().fold(f64::MIN, f64::max);
+    assert!(
+        slowest > 52.0 && fastest < 68.0,
+        "joint 1 at {slowest:.1}..{fastest:.1} deg/s across the missing sample (the stream: 60)"
+    );
+    wait_until_stopped(&mut robot);
+    assert_angles_near(
+        robot.measured_angles(),
+        degrees([1.2 * 29.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        "the stream's last target",
+    );
+}
+
+#[test]
+fn a_stream_sampled_late_is_followed_at_its_own_speed() {
+    // A client that samples its motion when it gets to send (a loop on a busy PC): each
+    // target of a 50 Hz stream ramping joint 1 at 60 deg/s goes out 0 to 10 ms late and
+    // carries the ramp at that late time. Played on the stream's steady beats, a target 10 ms
+    // late would be 10 ms of the ramp too far on for its beat, and the joint would lurch;
+    // played on their arrivals, it keeps the ramp's speed.
+    let mut robot = arm();
+    let start_us = robot.now_us();
+    let mut trace = Vec::new();
+    for k in 0..60u64 {
+        let late_us = (k.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 40) % 10_000;
+        let sent_us = k * 20_000 + late_us;
+        while robot.now_us() + 1_000 <= start_us + sent_us {
+            robot.run_for(1_000);
+            trace.push((robot.now_us(), robot.shaft_angles_deg()[0]));
+        }
+        robot.run_until(start_us + sent_us);
+        ack(
+            &mut robot,
+            Request::SendAngles {
+                angles: degrees([60.0 * sent_us as f64 / 1e6, 0.0, 0.0, 0.0, 0.0, 0.0]),
+                speed: speed(100),
+            },
+        );
+    }
+    // The speed over each 10 ms once the joint is under way (the shaft reads in whole encoder
+    // steps), until the last target.
+    let under_way: Vec<_> = trace
+        .iter()
+        .filter(|(t, _)| *t >= start_us + 300_000)
+        .collect();
+    let speeds: Vec<f64> = under_way
+        .iter()
+        .filter_map(|(t0, a0)| {
+            let (t1, a1) = under_way.iter().find(|(t, _)| *t >= t0 + 10_000)?;
+            Some((a1 - a0) / ((t1 - t0) as f64 / 1e6))
+        })
+        .collect();
+    let slowest = speeds.iter().copied().fold(f64::MAX, f64::min);
+    let fastest = speeds.iter().copied().fold(f64::MIN, f64::max);
+    assert!(
+        slowest > 45.0 && fastest < 75.0,
+        "joint 1 at {slowest:.1}..{fastest:.1} deg/s (the stream: 60)"
+    );
+}
+
+#[test]
 fn a_stream_sample_that_comes_late_is_not_taken_for_the_end_of_the_stream() {
     // A busy host holds its samples up for 120 ms (six periods), then sends the next ones on
     // time: while it waits, the arm goes on to a halt just past the last target instead of

@@ -1,12 +1,15 @@
 //! Following a sequence of joint targets (a host's stream, or the points of a Cartesian path)
 //! without stopping between them.
 //!
-//! A target comes with the time until the next one is due (the stream's period, or the path's
-//! interpolation period). Each joint gets the goal speed that carries it from where it is now
-//! to the target in that time, so it passes the target just as the next one arrives. Its goal
-//! lies beyond the target by the distance the servo needs to brake from that speed (plus a
-//! quarter period for a late target and a step for rounding), so the servo never starts
-//! braking while targets keep coming; the last target of a sequence is the goal itself.
+//! A target comes with the time until it is to be passed (a path's interpolation period, or
+//! for a stream the time to the target's beat on the stream's own clock, [`super::stream`]).
+//! Each joint gets the goal speed that carries it from where it is now to the target in that
+//! time, so it passes the target just as it heads for the next one. Its goal lies beyond the
+//! target by the distance the servo needs to brake from that speed (plus a quarter period for a
+//! late next leg and a step for rounding), so the servo never starts braking while targets keep
+//! coming; the last target of a sequence is the goal itself. A path's legs come one period
+//! apart; a stream's come when its targets and beats do ([`Clock`]), and where each joint is
+//! then is worked out for that time.
 
 use protocol_core::units::{Centideg, Steps};
 
@@ -39,13 +42,30 @@ pub enum Pace {
     Together,
 }
 
+/// When the legs of a sequence come.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Clock {
+    /// One period apart (a path's points): where the joints are is where the previous leg
+    /// took them.
+    Periodic,
+    /// At their own times (a stream's, when its targets and its beats come): where the joints
+    /// are is worked out for the time the leg is given, and each keeps its speed past the
+    /// target for a quarter of the stream's `period_us`, should the next leg be late.
+    Timed {
+        /// The stream's period, microseconds.
+        period_us: u64,
+    },
+}
+
 /// One target of a sequence and how to get there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Leg {
-    /// The joint angles to pass.
-    pub target: [Centideg; JOINTS],
-    /// Time until the next target is due, microseconds.
+    /// The joint positions to pass, thousandths of a step ([`millisteps`]).
+    pub target: [i64; JOINTS],
+    /// Time until the target is to be passed, microseconds.
     pub period_us: u64,
+    /// When the legs come.
+    pub clock: Clock,
     /// No joint faster than this, steps per second.
     pub speed_cap_steps_per_s: u32,
     /// How the joints change speed.
@@ -54,12 +74,51 @@ pub struct Leg {
     pub last: bool,
 }
 
+/// The previous leg, as given.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Given {
+    /// When, monotonic microseconds.
+    at_us: u64,
+    /// Where each joint was taken to be then, thousandths of a step.
+    from: [i64; JOINTS],
+    /// Where each joint should be one period later, thousandths of a step.
+    expected: [i64; JOINTS],
+    /// The speed each joint was given, steps per second (signed), as computed.
+    speeds: [i64; JOINTS],
+    /// The same as the whole-step speed register it went out as (signed).
+    rates: [i64; JOINTS],
+    /// Each joint's goal, thousandths of a step.
+    goals: [i64; JOINTS],
+}
+
+impl Given {
+    /// Where joint `j` should be at `now_us`: on at its speed from where it was, no further
+    /// than its goal (where the servo stops).
+    fn expected_at(&self, now_us: u64, j: usize) -> Option<i64> {
+        let (from, rate, goal) = (*self.from.get(j)?, *self.rates.get(j)?, *self.goals.get(j)?);
+        let elapsed = now_us.saturating_sub(self.at_us).min(1 << 32) as i64;
+        let on = from + rate * elapsed / 1000;
+        Some(match rate.signum() {
+            1 => on.min(goal.max(from)),
+            -1 => on.max(goal.min(from)),
+            _ => from,
+        })
+    }
+}
+
 /// Follows a sequence of targets. See the [module doc](self).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Follower {
-    /// Where each joint should be now, thousandths of a step, and the speed it was given,
-    /// steps per second (signed).
-    last: Option<([i64; JOINTS], [i64; JOINTS])>,
+    last: Option<Given>,
+}
+
+/// Joint angles as positions, thousandths of a step.
+pub fn millisteps(settings: &Settings, angles: &[Centideg; JOINTS]) -> [i64; JOINTS] {
+    let config = settings.config();
+    core::array::from_fn(|j| {
+        let angle = angles.get(j).copied().unwrap_or_default();
+        config.angle_to_millisteps(j, i32::from(angle.0))
+    })
 }
 
 impl Follower {
@@ -70,6 +129,7 @@ impl Follower {
         let Leg {
             target,
             period_us,
+            clock,
             speed_cap_steps_per_s,
             pace,
             last,
@@ -77,13 +137,16 @@ impl Follower {
         let config = settings.config();
         let full = i64::from(config.motion.servo_accel_steps_per_s2.max(100));
         let period = period_us.max(1) as i64;
+        let (timed, late_us) = match clock {
+            Clock::Periodic => (false, period),
+            Clock::Timed { period_us } => (true, period_us.max(1) as i64),
+        };
         let cap = i64::from(speed_cap_steps_per_s.max(1));
         // Every joint that holds torque follows, whether or not its latest reads came back: it
         // still hears the goals, and one left without them would run on to its last goal.
         let driven: [bool; JOINTS] = core::array::from_fn(|j| bank.holds_torque(j));
         let to: [i64; JOINTS] = core::array::from_fn(|j| {
-            let angle = target.get(j).copied().unwrap_or_default();
-            let exact = config.angle_to_millisteps(j, i32::from(angle.0));
+            let exact = target.get(j).copied().unwrap_or_default();
             if last {
                 // A servo at rest holds a whole step: head for that one.
                 i64::from(goal_position(settings, j, exact).0) * 1000
@@ -98,19 +161,24 @@ impl Follower {
         let from: [i64; JOINTS] = core::array::from_fn(|j| {
             let measured = bank.observed(cx.now_us, j).map(|m| m.millisteps);
             let told = || bank.motion(cx.now_us, j).map_or(0, |m| m.millisteps);
+            let should = |g: &Given| {
+                if timed {
+                    g.expected_at(cx.now_us, j)
+                } else {
+                    g.expected.get(j).copied()
+                }
+            };
             match &self.last {
-                Some((expected, _)) if !last => {
-                    let e = expected.get(j).copied().unwrap_or_else(told);
+                Some(g) if !last => {
+                    let e = should(g).unwrap_or_else(told);
                     measured.map_or(e, |m| e + (m - e) * CORRECTION.0 / CORRECTION.1)
                 }
-                Some((expected, _)) => measured
-                    .or_else(|| expected.get(j).copied())
-                    .unwrap_or_else(told),
+                Some(g) => measured.or_else(|| should(g)).unwrap_or_else(told),
                 None => measured.unwrap_or_else(told),
             }
         });
         let before: [i64; JOINTS] = match &self.last {
-            Some((_, speeds)) => *speeds,
+            Some(g) => g.speeds,
             None => core::array::from_fn(|j| {
                 bank.observed(cx.now_us, j)
                     .or_else(|| bank.motion(cx.now_us, j))
@@ -144,6 +212,8 @@ impl Follower {
         let together_us = (largest * 1_000_000 / full).max(1_000);
         let mut goals = Goals::NONE;
         let mut expected = to;
+        let mut rates = [0; JOINTS];
+        let mut goal_at = to;
         for j in 0..JOINTS {
             if !driven.get(j).copied().unwrap_or(false) {
                 continue;
@@ -163,7 +233,7 @@ impl Follower {
                 0
             } else {
                 speed * speed.abs() * 1000 / (2 * accel)
-                    + speed * period / 4000
+                    + speed * late_us / 4000
                     + speed.signum() * 1000
             };
             let speed_register = speed.unsigned_abs().max(1) as u16;
@@ -179,9 +249,22 @@ impl Follower {
                 speed_steps_per_s: speed_register,
                 accel: accel_register,
             };
+            if let Some(r) = rates.get_mut(j) {
+                *r = speed.signum() * i64::from(speed_register);
+            }
+            if let Some(g) = goal_at.get_mut(j) {
+                *g = i64::from(goal.position.0) * 1000;
+            }
             goals.set(j, Some(goal));
         }
-        self.last = Some((expected, speeds));
+        self.last = Some(Given {
+            at_us: cx.now_us,
+            from,
+            expected,
+            speeds,
+            rates,
+            goals: goal_at,
+        });
         goals
     }
 }
@@ -207,8 +290,9 @@ mod tests {
 
     fn leg(target: [Centideg; JOINTS], last: bool) -> Leg {
         Leg {
-            target,
+            target: millisteps(&powered(), &target),
             period_us: PERIOD_US,
+            clock: Clock::Periodic,
             speed_cap_steps_per_s: 3_000,
             pace: Pace::Free,
             last,

@@ -7,9 +7,12 @@
 //!   arc is walked whole with the inverse kinematics before it is accepted.
 //! * **Streams**: in fresh mode, full targets that arrive within [`STREAM_GAP_MAX_US`] of each
 //!   other (a ROS node sending `send_angles` on every joint state) are followed without
-//!   stopping between them, each reached about one stream period after it arrived; a stream
-//!   that stops (no target for [`STREAM_GAP_MAX_US`]: a late target is not its end) ends at
-//!   its last target.
+//!   stopping between them ([`stream`]): the Atom learns the stream's own clock from the
+//!   arrivals and passes each target one period after its beat was due, whenever it arrived,
+//!   or, for a host that samples its motion when it sends ([`timing`]), one period after its
+//!   arrival; a late or missing target is bridged along the stream's own motion for up to
+//!   [`BRIDGE_US`]. A stream that stops (no target for [`STREAM_GAP_MAX_US`]: a late
+//!   target is not its end) ends at its last target.
 //! * **Braking**: stop, pause, jog stop, the jog watchdog and a new move that replaces a
 //!   moving one bring every joint to rest at the servos' full deceleration, all joints along
 //!   the path they were on ([`brake`]); a replacing move starts from rest.
@@ -26,6 +29,7 @@ mod follow;
 mod path;
 pub mod plan;
 mod stream;
+mod timing;
 
 use heapless::Deque;
 use protocol_core::command::{MoveMode, Pose, PositionTarget};
@@ -39,12 +43,12 @@ use crate::error::AtomError;
 use crate::tolerance;
 use brake::Braking;
 pub use brake::stop_one;
-use follow::{Follower, Leg, Pace};
+use follow::{Clock, Follower, Leg, Pace, millisteps};
 pub use path::plan_arc;
 use path::{PathRunner, Step};
 pub use plan::MOVE_OVERTIME_US;
-pub use stream::STREAM_GAP_MAX_US;
-use stream::{StreamClock, stream_ended};
+use stream::{Aim, StreamClock, stream_ended};
+pub use stream::{BRIDGE_US, STREAM_GAP_MAX_US};
 
 /// Motions waiting in queue mode (fresh mode 0). 16 moves: a script sending a short path
 /// without waiting; more is refused (answer 0) rather than silently dropped.
@@ -214,9 +218,11 @@ enum Activity {
         speed_percent: u8,
         jog: Option<Jog>,
     },
-    /// Following a stream whose last target arrived at `last_us`.
+    /// Following a stream whose last target arrived at `last_us`, heading for `aim` (on the
+    /// stream's beats; `None` while its targets are played after their arrivals).
     Stream {
         follower: Follower,
+        aim: Option<Aim>,
         target: [Centideg; JOINTS],
         speed_percent: u8,
         period_us: u64,
@@ -328,16 +334,18 @@ impl MotionController {
         self.queue.clear();
         self.paused = None;
         let full = full_angles(&target.angles);
-        let period = match full {
-            Some(_) => self.clock.arrival(cx.now_us),
+        let beat = match full {
+            Some(angles) => self
+                .clock
+                .arrival(cx.now_us, millisteps(cx.settings, &angles)),
             None => {
                 self.clock.reset();
                 None
             }
         };
-        match (full, period) {
-            (Some(angles), Some(period_us)) => {
-                self.follow_stream(cx, angles, target.speed_percent, period_us)
+        match (full, beat) {
+            (Some(angles), Some(beat)) => {
+                self.follow_stream(cx, angles, target.speed_percent, beat.period_us)
             }
             _ => self.replace(cx, Order::Move(target)),
         }
@@ -725,8 +733,9 @@ impl MotionController {
                         *target = angles;
                     }
                     let leg = Leg {
-                        target: angles,
+                        target: millisteps(cx.settings, &angles),
                         period_us,
+                        clock: Clock::Periodic,
                         speed_cap_steps_per_s: runner.joint_speed_cap(),
                         pace: Pace::Together,
                         last,
@@ -740,25 +749,35 @@ impl MotionController {
             }
             Activity::Stream {
                 follower,
+                aim,
                 target,
                 speed_percent,
                 period_us: stream_period_us,
                 last_us,
             } => {
+                let cap = cx.settings.config().joint_speed_steps(*speed_percent);
                 if stream_ended(now_us, *last_us) {
                     let leg = Leg {
-                        target: *target,
+                        target: millisteps(cx.settings, target),
                         period_us: *stream_period_us,
-                        speed_cap_steps_per_s: cx
-                            .settings
-                            .config()
-                            .joint_speed_steps(*speed_percent),
+                        clock: Clock::Timed {
+                            period_us: *stream_period_us,
+                        },
+                        speed_cap_steps_per_s: cap,
                         pace: Pace::Free,
                         last: true,
                     };
                     let goals = follower.goals_towards(cx, &leg);
                     cx.send_goals(goals)?;
                     next = Some(arriving(now_us, *target, *speed_percent, *stream_period_us));
+                } else if aim.is_none_or(|a| now_us >= a.reach_us)
+                    && let Some(next_aim) = self.clock.aim(now_us, lead_us(*stream_period_us))
+                    && Some(next_aim) != *aim
+                {
+                    // The beat is passed: on to the next one, arrived or bridged.
+                    let leg = stream_leg(&next_aim, now_us, *stream_period_us, cap);
+                    cx.send_goals(follower.goals_towards(cx, &leg))?;
+                    *aim = Some(next_aim);
                 }
             }
             Activity::Braking {
@@ -943,7 +962,8 @@ impl MotionController {
         Ok(())
     }
 
-    /// Follows the next target of a stream that arrives every `period_us`.
+    /// Follows a stream whose target `angles` just arrived (the clock has it): the joints head
+    /// for the first beat still ahead ([`StreamClock::aim`]), unless they already do.
     fn follow_stream(
         &mut self,
         cx: &mut Context<'_>,
@@ -951,27 +971,46 @@ impl MotionController {
         speed_percent: u8,
         period_us: u64,
     ) -> Result<(), AtomError> {
-        let mut follower = match self.activity {
-            Activity::Stream { follower, .. } => follower,
-            _ => Follower::default(),
+        let (mut follower, heading) = match self.activity {
+            Activity::Stream { follower, aim, .. } => (follower, aim),
+            _ => (Follower::default(), None),
         };
-        let leg = Leg {
-            target: angles,
-            period_us,
-            speed_cap_steps_per_s: cx.settings.config().joint_speed_steps(speed_percent),
-            pace: Pace::Free,
-            last: false,
-        };
-        let goals = follower.goals_towards(cx, &leg);
-        cx.send_goals(goals)?;
+        let aim = self.clock.aim(cx.now_us, lead_us(period_us)).or(heading);
+        if let Some(aim) = aim
+            && heading != Some(aim)
+        {
+            let cap = cx.settings.config().joint_speed_steps(speed_percent);
+            let leg = stream_leg(&aim, cx.now_us, period_us, cap);
+            cx.send_goals(follower.goals_towards(cx, &leg))?;
+        }
         self.activity = Activity::Stream {
             follower,
+            aim,
             target: angles,
             speed_percent,
             period_us,
             last_us: cx.now_us,
         };
         Ok(())
+    }
+}
+
+/// How far ahead of now a stream's joints aim at the least: a quarter period, so that a target
+/// that arrives just before its beat is passed is not rushed to.
+fn lead_us(period_us: u64) -> u64 {
+    period_us / 4
+}
+
+/// The leg towards `aim` from `now_us` of a stream that comes every `period_us`, no joint
+/// faster than `cap` steps/s.
+fn stream_leg(aim: &Aim, now_us: u64, period_us: u64, cap: u32) -> Leg {
+    Leg {
+        target: aim.at,
+        period_us: aim.reach_us.saturating_sub(now_us).max(1),
+        clock: Clock::Timed { period_us },
+        speed_cap_steps_per_s: cap,
+        pace: Pace::Free,
+        last: false,
     }
 }
 
