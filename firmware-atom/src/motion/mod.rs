@@ -11,7 +11,7 @@
 //!   arrivals and passes each target one period after its beat was due, whenever it arrived,
 //!   or, for a host that samples its motion when it sends ([`timing`]), one period after its
 //!   arrival; a late or missing target is bridged along the stream's own motion for up to
-//!   [`BRIDGE_US`]. A stream that stops (no target for [`STREAM_GAP_MAX_US`]: a late
+//!   [`BRIDGE_US`] (one period on arrivals). A stream that stops (no target for [`STREAM_GAP_MAX_US`]: a late
 //!   target is not its end) ends at its last target.
 //! * **Braking**: stop, pause, jog stop, the jog watchdog and a new move that replaces a
 //!   moving one bring every joint to rest at the servos' full deceleration, all joints along
@@ -218,8 +218,8 @@ enum Activity {
         speed_percent: u8,
         jog: Option<Jog>,
     },
-    /// Following a stream whose last target arrived at `last_us`, heading for `aim` (on the
-    /// stream's beats; `None` while its targets are played after their arrivals).
+    /// Following a stream whose last target arrived at `last_us`, heading for `aim` (a beat's
+    /// target, or one played after its arrival; `None` until the clock has one).
     Stream {
         follower: Follower,
         aim: Option<Aim>,

@@ -36,9 +36,9 @@
 //! is then 10 ms of motion further on, and read as a beat's it throws the joints off the path
 //! (and its value made the clock count beats that never were). Which of the two a stream does
 //! is judged from its values ([`super::timing`]); a stream sampled when sent has no beats: its
-//! period is the mean gap over the last [`GAP_WINDOW`] arrivals, and each target is passed one
-//! period (and [`SLACK_US`]) after its own arrival, bridged past the newest along the stream's
-//! speed ([`StreamClock::aim`]).
+//! period follows the mean gap over the last [`GAP_WINDOW`] arrivals ([`ARRIVAL_PERIOD_FADE`]),
+//! and each target is passed one period (and [`SLACK_US`]) after its own arrival, bridged past
+//! the newest at the stream's speed for one period ([`StreamClock::aim`]).
 //!
 //! The stream is only over when no target can continue it any more ([`STREAM_GAP_MAX_US`]).
 
