@@ -92,9 +92,10 @@ impl Rig {
             first_end.get_or_insert(end);
             while self.now() < deadline {
                 self.tick();
-                if self.now() <= end + TICK_US && self.atom_talked_between(start, end) {
-                    // Both started on the same quiet wire and garbled each other: the real
-                    // Basic sees its echo differ and sends again once the wire is quiet.
+                if self.now() <= end + TICK_US && self.another_talked_between(start, end) {
+                    // Another station (the Atom, or a servo answering late) talked over the
+                    // frame and garbled it: the real Basic sees its echo differ and sends
+                    // again once the wire is quiet.
                     while self.now() <= end + 2 * TICK_US {
                         self.tick();
                     }
@@ -109,14 +110,15 @@ impl Rig {
         None
     }
 
-    /// True if the Atom transmitted while the host's frame was on the wire (a collision).
-    fn atom_talked_between(&self, start: u64, end: u64) -> bool {
+    /// True if the Atom or a servo transmitted while the host's frame was on the wire (a
+    /// collision).
+    fn another_talked_between(&self, start: u64, end: u64) -> bool {
         self.bus
             .trace
             .iter()
             .rev()
             .take(256)
-            .any(|&(t, who, _)| who == 'A' && t > start && t <= end)
+            .any(|&(t, who, _)| who != 'H' && t > start && t <= end)
     }
 
     pub fn request(&mut self, frame: &Frame) -> Option<Frame> {
