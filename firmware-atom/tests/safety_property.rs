@@ -191,3 +191,48 @@ proptest! {
         }
     }
 }
+
+/// One sample of a host's stream: the gap before it (microseconds), its angles (centidegrees,
+/// now and then past a limit) and its speed (20 % and up: the arm then crosses any distance
+/// within seconds).
+fn stream_sample() -> impl Strategy<Value = (u64, [i16; 6], u8)> {
+    let gap = prop_oneof![
+        3 => 15_000u64..25_000,
+        2 => 0u64..4_000,
+        1 => 0u64..200_000,
+    ];
+    let angle = prop_oneof![6 => -9_000i16..9_000, 1 => -20_000i16..20_000];
+    (gap, prop::array::uniform6(angle), 20u8..=100)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Streams of any timing and any values (regular, late, in bursts, with stalls; smooth or
+    /// jumping about, past the limits): whichever clock the Atom plays them on and however it
+    /// bridges their gaps, no goal leaves a joint's range, and once the stream stops the arm
+    /// comes to rest (within the time its slowest speed takes to cross the encoder range).
+    #[test]
+    fn no_stream_sends_an_out_of_limit_goal_or_runs_on(samples in prop::collection::vec(stream_sample(), 2..80)) {
+        let config = AtomConfig { powered_at_boot: true, ..AtomConfig::default() };
+        let mut rig = Rig::with(config, true);
+        for (gap_us, angles, speed) in &samples {
+            rig.run_us(*gap_us);
+            let mut data = support::rig::be(angles);
+            data.push(*speed);
+            // As the Basic sends it: on a quiet bus, again after a collision.
+            prop_assert!(rig.request(&Frame::new(0x22, &data).unwrap()).is_some(), "a sample unanswered");
+        }
+        // Long enough for the slowest sample's speed to cross the whole encoder range, and a
+        // second for the ramps.
+        let slowest = samples.iter().map(|s| s.2).min().unwrap_or(100);
+        let crossing_ms = 4_096 * 1_000 / u64::from(config.joint_speed_steps(slowest));
+        rig.run_ms(crossing_ms + 1_000);
+        for (j, (goals, limit)) in rig.bus.goals.iter().zip(&FACTORY_LIMITS).enumerate() {
+            for &g in goals {
+                prop_assert!(within(limit, g, &config, j), "joint {} goal {}", j + 1, g);
+            }
+        }
+        prop_assert_eq!(rig.ask(0x2B, &[]), vec![0u8], "still moving {} ms after the stream", crossing_ms + 1_000);
+    }
+}
