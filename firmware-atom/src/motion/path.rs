@@ -17,6 +17,8 @@ use crate::config::{JOINTS, STEPS_PER_TURN};
 use crate::error::AtomError;
 use crate::settings::Settings;
 
+use super::follow::millisteps;
+
 /// Micrometres per tenth of a millimetre.
 const UM_PER_TENTH_MM: i64 = 100;
 /// Path micrometres per centidegree of rotation ([`kinematics_core::path`]'s measure).
@@ -313,14 +315,8 @@ fn nearest_on_steps(
     q: &[Centideg; JOINTS],
     end: &Transform,
 ) -> [Centideg; JOINTS] {
-    let config = settings.config();
     let model = settings.cart().model();
-    let below: [i64; JOINTS] = core::array::from_fn(|j| {
-        let angle = q.get(j).copied().unwrap_or_default();
-        config
-            .angle_to_millisteps(j, i32::from(angle.0))
-            .div_euclid(1000)
-    });
+    let below = millisteps(settings, q).map(|m| m.div_euclid(1000));
     let mut best = (i128::MAX, *q);
     for choice in 0u32..(1 << JOINTS) {
         let angles: [Centideg; JOINTS] = core::array::from_fn(|j| {
